@@ -1,0 +1,12 @@
+# Compiler warnings and sanitizer flags shared by every ldc target.
+add_library(ldc_build_flags INTERFACE)
+if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+  target_compile_options(ldc_build_flags INTERFACE
+    $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
+      -Wcast-align -Woverloaded-virtual -Wimplicit-fallthrough>)
+endif()
+if(LDC_SANITIZE)
+  target_compile_options(ldc_build_flags INTERFACE
+    -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
+  target_link_options(ldc_build_flags INTERFACE -fsanitize=address,undefined)
+endif()

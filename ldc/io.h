@@ -1,0 +1,55 @@
+// .ldc files: a World on disk.
+//
+// Layout (little-endian), version 1:
+//   header    magic "LDCW", format version, lattice, chunk size, chunk box,
+//             counts and section sizes, CRC-32 of the header itself
+//   metadata  key/value strings, CRC-32
+//   table     one record per chunk slot: kind, and for mixed chunks the offset,
+//             compressed and raw size of its payload and a CRC-32 of the
+//             compressed bytes; CRC-32 of the table
+//   payload   one zstd frame per mixed chunk (so chunks load independently)
+// A chunk payload holds, per axis: a uniform flag, the start-inside bits, the
+// point count of every ray and the 8-byte points.
+//
+// Loading trusts nothing: every size is checked against the file size and the
+// format's limits before anything is allocated, every checksum is verified,
+// every chunk is validated (sorted, alternating, in range, axes agree), and
+// the first problem found is returned as kCorruptData naming the section,
+// chunk and field.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "ldc/context.h"
+#include "ldc/status.h"
+#include "ldc/world.h"
+
+namespace ldc {
+
+inline constexpr uint32_t kLdcFormatVersion = 1;
+
+struct SaveOptions {
+  int compression_level = 3;  // zstd level [Limit: 1 .. 19]
+};
+
+struct LoadLimits {
+  size_t max_file_bytes = size_t{16} << 30;   // refuse larger files
+  size_t max_chunk_raw_bytes = size_t{64} << 20;  // one chunk, uncompressed
+  size_t max_total_raw_bytes = size_t{16} << 30;  // all chunks, uncompressed
+};
+
+Status save_world(const World& world, const std::string& path, const SaveOptions& options = {},
+                  Context* ctx = nullptr);
+Result<std::vector<uint8_t>> serialize_world(const World& world, const SaveOptions& options = {},
+                                             Context* ctx = nullptr);
+
+Result<World> load_world(const std::string& path, const LoadLimits& limits = {},
+                         Context* ctx = nullptr);
+// `name` is used in messages.
+Result<World> deserialize_world(std::string_view bytes, std::string_view name,
+                                const LoadLimits& limits = {}, Context* ctx = nullptr);
+
+}  // namespace ldc

@@ -1,0 +1,86 @@
+// Triangle meshes: the in-memory form and the file loaders (OBJ, PLY, STL, OFF).
+//
+// Loaders triangulate polygons, keep OBJ `usemtl` groups as material ids and
+// refuse malformed input with a message naming the file, the line (text
+// formats) or byte offset (binary formats) and the offending value. They never
+// crash and never allocate more than the file's own size justifies.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "ldc/status.h"
+
+namespace ldc {
+
+struct TriangleMesh {
+  std::vector<glm::dvec3> positions;
+  std::vector<glm::uvec3> triangles;        // counter-clockwise seen from outside
+  // Empty, or one id per triangle. parse_obj numbers `usemtl` names in the
+  // order first seen (id 0 = the first); faces before the first `usemtl` get
+  // the name "default", registered only if such faces exist. A file without
+  // any `usemtl` leaves both vectors empty, as do the other formats.
+  std::vector<uint16_t> triangle_material;
+  std::vector<std::string> material_names;  // id -> name (OBJ usemtl), may be empty
+
+  size_t triangle_count() const { return triangles.size(); }
+  uint16_t material_of(size_t triangle) const {
+    return triangle_material.empty() ? uint16_t{0} : triangle_material[triangle];
+  }
+};
+
+struct MeshBounds {
+  glm::dvec3 min{0.0};
+  glm::dvec3 max{0.0};
+  glm::dvec3 extent() const { return max - min; }
+  double diagonal() const;
+};
+
+// Bounds of the vertices referenced by triangles. Requires a non-empty mesh.
+MeshBounds mesh_bounds(const TriangleMesh& mesh);
+
+// Signed volume (positive for outward-facing closed meshes).
+double mesh_signed_volume(const TriangleMesh& mesh);
+
+// Checks indices, finite coordinates and material ids; names the first bad one.
+Status check_mesh(const TriangleMesh& mesh, std::string_view name = "mesh");
+
+// What the topology looks like (vertices welded by exact position).
+struct MeshTopology {
+  size_t boundary_edges = 0;      // edges used once
+  size_t nonmanifold_edges = 0;   // edges used by more than two triangles
+  size_t unbalanced_edges = 0;    // edges whose two directions are not used equally often
+  size_t degenerate_triangles = 0;
+  bool closed() const { return unbalanced_edges == 0; }
+};
+MeshTopology mesh_topology(const TriangleMesh& mesh);
+
+struct LoadOptions {
+  // Refuse files with more triangles than this [Limit: >= 1].
+  size_t max_triangles = size_t{1} << 28;
+};
+
+// Picks the format by extension (.obj .ply .stl .off, case-insensitive).
+Result<TriangleMesh> load_mesh(const std::string& path, const LoadOptions& options = {});
+
+// Parsers over bytes already in memory; `name` is used in messages.
+// Polygons are ear-clipped in their best-fit plane (a k-gon gives k - 2
+// triangles; degenerate ones, and any over 256 corners, are fanned instead).
+// STL corners at exactly the same position are welded into one vertex.
+Result<TriangleMesh> parse_obj(std::string_view bytes, std::string_view name,
+                               const LoadOptions& options = {});
+Result<TriangleMesh> parse_ply(std::string_view bytes, std::string_view name,
+                               const LoadOptions& options = {});
+Result<TriangleMesh> parse_stl(std::string_view bytes, std::string_view name,
+                               const LoadOptions& options = {});
+Result<TriangleMesh> parse_off(std::string_view bytes, std::string_view name,
+                               const LoadOptions& options = {});
+
+// Writes a Wavefront OBJ (positions and faces, `usemtl` groups when materials are set).
+Status save_obj(const TriangleMesh& mesh, const std::string& path);
+
+}  // namespace ldc

@@ -1,0 +1,25 @@
+#include "ldc/status.h"
+
+namespace ldc {
+
+const char* error_code_name(ErrorCode code) {
+  switch (code) {
+    case ErrorCode::kOk: return "ok";
+    case ErrorCode::kInvalidArgument: return "invalid argument";
+    case ErrorCode::kParseError: return "parse error";
+    case ErrorCode::kIoError: return "i/o error";
+    case ErrorCode::kCorruptData: return "corrupt data";
+    case ErrorCode::kTooLarge: return "too large";
+    case ErrorCode::kUnsupported: return "unsupported";
+    case ErrorCode::kCancelled: return "cancelled";
+    case ErrorCode::kInternal: return "internal error";
+  }
+  return "unknown error";
+}
+
+std::string Status::to_string() const {
+  if (ok()) return "ok";
+  return std::string(error_code_name(code_)) + ": " + message_;
+}
+
+}  // namespace ldc

@@ -1,0 +1,222 @@
+// validate(): every invariant of the LDC, checked chunk by chunk in parallel.
+#include <array>
+#include <atomic>
+#include <bit>
+#include <tuple>
+#include <cmath>
+#include <mutex>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+
+#include "ldc/detail/ray_math.h"
+#include "ldc/world.h"
+
+namespace ldc {
+namespace {
+
+// A normal may lean this far to the wrong side of the ray's plane before it
+// counts as pointing into the solid; covers the octahedral quantization error.
+constexpr float kNormalSideTolerance = 1e-3f;
+
+// Collects error messages from many threads, keeping the first few.
+class ErrorSink {
+ public:
+  explicit ErrorSink(size_t max_messages) : max_(max_messages) {}
+  void add(std::string message) {
+    size_t n = count_.fetch_add(1);
+    if (n >= max_) return;
+    std::lock_guard<std::mutex> lock(mutex_);
+    messages_.push_back(std::move(message));
+  }
+  size_t count() const { return count_.load(); }
+  std::vector<std::string> take() { return std::move(messages_); }
+
+ private:
+  size_t max_;
+  std::atomic<size_t> count_{0};
+  std::mutex mutex_;
+  std::vector<std::string> messages_;
+};
+
+std::string where(const glm::ivec3& chunk, int axis, int ray) {
+  std::ostringstream s;
+  s << "chunk (" << chunk.x << "," << chunk.y << "," << chunk.z << ") axis " << axis_name(axis);
+  if (ray >= 0) s << " ray " << ray;
+  return s.str();
+}
+
+// Structure of one family's arrays.
+bool check_family_arrays(const RayFamily& f, int c, const glm::ivec3& coord, int axis,
+                         ErrorSink& sink) {
+  if (f.is_uniform()) return true;
+  std::string why = f.check_structure();
+  if (!why.empty()) {
+    sink.add(where(coord, axis, -1) + ": " + why);
+    return false;
+  }
+  bool any_in = false, any_out = false;
+  for (int r = 0; r < c * c; ++r) (f.starts_inside(r) ? any_in : any_out) = true;
+  if (f.all_points().empty() && !(any_in && any_out)) {
+    sink.add(where(coord, axis, -1) + ": family holds no points and uniform rays but is not stored as uniform");
+  }
+  return true;
+}
+
+// Order, range, sense and normals of one ray segment. Messages are built only
+// for errors: this runs for every ray of every mixed chunk.
+void check_ray(const RayFamily& f, int axis, int ray, int c, const glm::ivec3& coord,
+               ErrorSink& sink) {
+  const uint32_t q = depth_steps_per_cell(c);
+  bool expect_enter = !f.starts_inside(ray);
+  uint32_t prev = 0;
+  auto pts = f.points(ray);
+  auto fail = [&](size_t i, const std::string& what) {
+    sink.add(where(coord, axis, ray) + " point " + std::to_string(i) + ": " + what);
+  };
+  for (size_t i = 0; i < pts.size(); ++i) {
+    const PackedPoint& p = pts[i];
+    if (p.depth % q == 0) fail(i, "depth " + std::to_string(p.depth) + " lies on a node");
+    if (i > 0 && p.depth <= prev) {
+      fail(i, "depth " + std::to_string(p.depth) + " not after " + std::to_string(prev));
+    }
+    if (p.normal & kPointReservedBit) fail(i, "reserved bit set");
+    if (p.enters() != expect_enter) {
+      fail(i, expect_enter ? "exit where an enter was due" : "enter where an exit was due");
+    }
+    glm::vec3 n = decode_normal(p.normal);
+    float len = glm::length(n);
+    if (!std::isfinite(len) || std::abs(len - 1.0f) > 1e-3f) fail(i, "normal not unit");
+    float side = p.enters() ? n[axis] : -n[axis];  // must be <= 0: pointing out of the solid
+    if (side > kNormalSideTolerance) fail(i, "normal points into the solid");
+    prev = p.depth;
+    expect_enter = !expect_enter;
+  }
+}
+
+// Node words of one family in the X layout: out[z*64 + y], bit x.
+void family_node_words(const RayFamily& f, int axis, int c, std::vector<uint64_t>& out) {
+  std::vector<uint64_t> fam(size_t(c) * c);
+  for (int r = 0; r < c * c; ++r) fam[r] = detail::node_word(f.starts_inside(r), f.points(r), c);
+  out.assign(size_t(c) * 64, 0);
+  detail::convert_layout(axis, c, fam.data(), out.data(), false);
+}
+
+size_t check_cross_axis(const Chunk& chunk, int c, const glm::ivec3& coord, ErrorSink& sink) {
+  std::array<std::vector<uint64_t>, 3> words;
+  for (int a = 0; a < 3; ++a) family_node_words(chunk.axis[a], a, c, words[a]);
+  size_t bad = 0;
+  for (int z = 0; z < c; ++z) {
+    for (int y = 0; y < c; ++y) {
+      uint64_t x = words[0][z * 64 + y];
+      uint64_t diff = (x ^ words[1][z * 64 + y]) | (x ^ words[2][z * 64 + y]);
+      if (diff == 0) continue;
+      ++bad;
+      int xi = std::countr_zero(diff);
+      sink.add(where(coord, 0, -1) + ": axes disagree at local node (" + std::to_string(xi) + "," +
+               std::to_string(y) + "," + std::to_string(z) + ")");
+    }
+  }
+  return bad;
+}
+
+void check_chunk(const Chunk& chunk, const glm::ivec3& coord, int c, bool cross_axis,
+                 ErrorSink& sink) {
+  bool arrays_ok = true;
+  for (int a = 0; a < 3; ++a) {
+    if (!check_family_arrays(chunk.axis[a], c, coord, a, sink)) {
+      arrays_ok = false;
+      continue;
+    }
+    if (chunk.axis[a].is_uniform()) continue;
+    for (int r = 0; r < c * c; ++r) check_ray(chunk.axis[a], a, r, c, coord, sink);
+  }
+  if (arrays_ok && cross_axis) check_cross_axis(chunk, c, coord, sink);
+}
+
+// End state of a ray segment: start state flipped once per point.
+bool segment_ends_inside(const World& w, const glm::ivec3& ch, int axis, int ray) {
+  ChunkKind kind = w.chunk_kind(ch);
+  if (kind != ChunkKind::kMixed) return kind == ChunkKind::kSolid;
+  const RayFamily& f = w.chunk(ch)->axis[axis];
+  return f.starts_inside(ray) != (f.points(ray).size() % 2 == 1);
+}
+
+bool segment_starts_inside(const World& w, const glm::ivec3& ch, int axis, int ray) {
+  ChunkKind kind = w.chunk_kind(ch);
+  if (kind != ChunkKind::kMixed) return kind == ChunkKind::kSolid;
+  return w.chunk(ch)->axis[axis].starts_inside(ray);
+}
+
+// Each ray leaves chunk ch in the state it enters the next chunk along the axis;
+// rays start and end outside at the world box.
+void check_continuity(const World& w, const glm::ivec3& ch, ErrorSink& sink) {
+  const int c = w.chunk_size();
+  for (int a = 0; a < 3; ++a) {
+    glm::ivec3 next = ch;
+    next[a] += 1;
+    bool first_in_box = ch[a] == w.chunk_origin()[a];
+    for (int r = 0; r < c * c; ++r) {
+      if (first_in_box && segment_starts_inside(w, ch, a, r)) {
+        sink.add(where(ch, a, r) + ": ray starts inside at the world box face");
+      }
+      if (segment_ends_inside(w, ch, a, r) != segment_starts_inside(w, next, a, r)) {
+        sink.add(where(ch, a, r) + ": ray state breaks at the boundary to the next chunk");
+      }
+    }
+  }
+}
+
+void check_slot(const World& w, const glm::ivec3& ch, ChunkKind kind, const Chunk* data,
+                bool cross_axis, ErrorSink& sink) {
+  if ((kind == ChunkKind::kMixed) != (data != nullptr)) {
+    sink.add(where(ch, 0, -1) + ": kind " + chunk_kind_name(kind) + " disagrees with its data");
+    return;
+  }
+  if (data) {
+    if (data->is_uniform(nullptr)) sink.add(where(ch, 0, -1) + ": uniform chunk stored as mixed");
+    check_chunk(*data, ch, w.chunk_size(), cross_axis, sink);
+  }
+  check_continuity(w, ch, sink);
+}
+
+}  // namespace
+
+std::string ValidationReport::summary() const {
+  std::ostringstream s;
+  s << (ok ? "valid" : "INVALID") << " (" << errors << " errors, " << nodes_checked
+    << " nodes checked across axes)";
+  for (const std::string& m : messages) s << "\n  " << m;
+  if (errors > messages.size()) s << "\n  ...";
+  return s.str();
+}
+
+ValidationReport validate(const World& world, const ValidateOptions& options) {
+  ErrorSink sink(options.max_messages);
+  std::vector<std::tuple<glm::ivec3, ChunkKind, const Chunk*>> slots;
+  world.for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk* data) {
+    slots.emplace_back(ch, kind, data);
+  });
+  std::atomic<size_t> mixed{0};
+  tbb::parallel_for(size_t{0}, slots.size(), [&](size_t i) {
+    auto [ch, kind, data] = slots[i];
+    if (kind == ChunkKind::kMixed) mixed.fetch_add(1);
+    check_slot(world, ch, kind, data, options.check_cross_axis, sink);
+  });
+  ValidationReport report;
+  report.errors = sink.count();
+  report.ok = report.errors == 0;
+  report.messages = sink.take();
+  const size_t c = size_t(world.chunk_size());
+  report.nodes_checked = options.check_cross_axis ? mixed.load() * c * c * c : 0;
+  return report;
+}
+
+Status validate_chunk(const Chunk& chunk, int chunk_size, bool check_cross_axis) {
+  ErrorSink sink(1);
+  check_chunk(chunk, glm::ivec3(0), chunk_size, check_cross_axis, sink);
+  if (sink.count() == 0) return {};
+  return {ErrorCode::kCorruptData, sink.take().front()};
+}
+
+}  // namespace ldc

@@ -1,0 +1,457 @@
+#include "ldc/world.h"
+
+#include <algorithm>
+#include <bit>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+#include "ldc/detail/ray_math.h"
+
+namespace ldc {
+
+const char* axis_name(int a) {
+  static const char* names[] = {"x", "y", "z"};
+  return (a >= 0 && a < 3) ? names[a] : "?";
+}
+
+const char* chunk_kind_name(ChunkKind kind) {
+  switch (kind) {
+    case ChunkKind::kEmpty: return "empty";
+    case ChunkKind::kSolid: return "solid";
+    case ChunkKind::kMixed: return "mixed";
+  }
+  return "?";
+}
+
+// ---------------------------------------------------------------------------
+// RayFamily
+
+RayFamily RayFamily::uniform(bool inside) {
+  RayFamily f;
+  f.uniform_inside_ = inside;
+  return f;
+}
+
+bool RayFamily::starts_inside(int ray) const {
+  if (is_uniform()) return uniform_inside_;
+  return (inside_[static_cast<size_t>(ray) >> 6] >> (ray & 63)) & 1u;
+}
+
+std::span<const PackedPoint> RayFamily::points(int ray) const {
+  if (is_uniform()) return {};
+  if (!first_.empty()) {
+    return std::span<const PackedPoint>(points_.data() + first_[ray], first_[ray + 1] - first_[ray]);
+  }
+  const int row = ray / size_;
+  uint32_t begin = row_first_[row];
+  for (int r = row * size_; r < ray; ++r) begin += counts_[r];
+  return std::span<const PackedPoint>(points_.data() + begin, counts_[ray]);
+}
+
+size_t RayFamily::memory_bytes() const {
+  return counts_.capacity() + (row_first_.capacity() + first_.capacity()) * sizeof(uint32_t) +
+         inside_.capacity() * sizeof(uint64_t) + points_.capacity() * sizeof(PackedPoint);
+}
+
+std::string RayFamily::check_structure() const {
+  if (is_uniform()) return {};
+  const size_t c = size_, rays = c * c;
+  if (inside_.size() != (rays + 63) / 64) return "start-bit array has the wrong size";
+  if (!first_.empty()) {
+    if (first_.size() != rays + 1 || first_[0] != 0 || first_[rays] != points_.size()) {
+      return "ray offsets do not cover the point array";
+    }
+    for (size_t r = 0; r < rays; ++r) {
+      if (first_[r + 1] < first_[r]) return "ray offsets decrease at ray " + std::to_string(r);
+    }
+    return {};
+  }
+  if (counts_.size() != rays || row_first_.size() != c + 1) return "count arrays have the wrong size";
+  for (size_t row = 0; row < c; ++row) {
+    uint32_t end = row_first_[row];
+    for (size_t r = row * c; r < (row + 1) * c; ++r) end += counts_[r];
+    if (row_first_[row + 1] != end) return "row offsets disagree with counts at row " + std::to_string(row);
+  }
+  if (row_first_[0] != 0 || row_first_[c] != points_.size()) return "row offsets do not cover the point array";
+  return {};
+}
+
+RayFamilyWriter::RayFamilyWriter(int chunk_size) : chunk_size_(chunk_size) {
+  const size_t rays = static_cast<size_t>(chunk_size) * chunk_size;
+  first_.reserve(rays + 1);
+  inside_.assign((rays + 63) / 64, 0);
+}
+
+void RayFamilyWriter::begin_ray(bool starts_inside) {
+  assert(rays_ < chunk_size_ * chunk_size_);
+  first_.push_back(static_cast<uint32_t>(points_.size()));
+  if (starts_inside) {
+    inside_[static_cast<size_t>(rays_) >> 6] |= uint64_t{1} << (rays_ & 63);
+    any_inside_ = true;
+  } else {
+    any_outside_ = true;
+  }
+  ++rays_;
+}
+
+RayFamily RayFamilyWriter::finish() {
+  const int c = chunk_size_;
+  assert(rays_ == c * c);
+  if (points_.empty() && !(any_inside_ && any_outside_)) return RayFamily::uniform(any_inside_);
+  RayFamily f;
+  f.size_ = static_cast<uint8_t>(c);
+  first_.push_back(static_cast<uint32_t>(points_.size()));
+  bool compact = true;
+  for (int r = 0; r < c * c && compact; ++r) compact = first_[r + 1] - first_[r] <= 255;
+  if (compact) {
+    f.counts_.resize(static_cast<size_t>(c) * c);
+    for (int r = 0; r < c * c; ++r) f.counts_[r] = static_cast<uint8_t>(first_[r + 1] - first_[r]);
+    f.row_first_.resize(static_cast<size_t>(c) + 1);
+    for (int row = 0; row <= c; ++row) f.row_first_[row] = first_[static_cast<size_t>(row) * c];
+  } else {
+    f.first_ = std::move(first_);
+  }
+  f.inside_ = std::move(inside_);
+  points_.shrink_to_fit();
+  f.points_ = std::move(points_);
+  return f;
+}
+
+// ---------------------------------------------------------------------------
+// Chunk
+
+bool Chunk::is_uniform(bool* inside) const {
+  for (const RayFamily& f : axis) {
+    if (!f.is_uniform()) return false;
+  }
+  bool in = axis[0].uniform_inside();
+  if (axis[1].uniform_inside() != in || axis[2].uniform_inside() != in) return false;
+  if (inside) *inside = in;
+  return true;
+}
+
+size_t Chunk::point_count() const {
+  return axis[0].point_count() + axis[1].point_count() + axis[2].point_count();
+}
+
+size_t Chunk::memory_bytes() const {
+  return sizeof(Chunk) + axis[0].memory_bytes() + axis[1].memory_bytes() +
+         axis[2].memory_bytes();
+}
+
+// ---------------------------------------------------------------------------
+// World
+
+namespace {
+
+bool is_allowed_chunk_size(int c) { return c == 8 || c == 16 || c == 32 || c == 64; }
+
+Status check_world_config(const WorldConfig& config) {
+  const Lattice& lat = config.lattice;
+  if (!(lat.cell_size > 0.0) || !std::isfinite(lat.cell_size)) {
+    return {ErrorCode::kInvalidArgument,
+            "world: cell_size = " + std::to_string(lat.cell_size) + " must be finite and > 0"};
+  }
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(lat.origin[a])) {
+      return {ErrorCode::kInvalidArgument,
+              std::string("world: origin.") + axis_name(a) + " is not finite"};
+    }
+  }
+  if (!is_allowed_chunk_size(config.chunk_size)) {
+    return {ErrorCode::kInvalidArgument, "world: chunk_size = " +
+                                             std::to_string(config.chunk_size) +
+                                             " must be 8, 16, 32 or 64"};
+  }
+  int64_t slots = 1;
+  for (int a = 0; a < 3; ++a) {
+    int64_t dim = config.chunk_dims[a];
+    if (dim < 1) {
+      return {ErrorCode::kInvalidArgument, std::string("world: chunk_dims.") + axis_name(a) +
+                                               " = " + std::to_string(dim) + " must be >= 1"};
+    }
+    int64_t lo = int64_t{config.chunk_origin[a]} * config.chunk_size;
+    int64_t hi = (int64_t{config.chunk_origin[a]} + dim) * config.chunk_size;
+    if (lo < -kMaxNodeCoordinate || hi > kMaxNodeCoordinate) {
+      return {ErrorCode::kTooLarge,
+              std::string("world: node range on ") + axis_name(a) + " [" + std::to_string(lo) +
+                  ", " + std::to_string(hi) + ") exceeds +-" + std::to_string(kMaxNodeCoordinate)};
+    }
+    slots *= dim;
+    if (slots > kMaxChunkSlots) {
+      return {ErrorCode::kTooLarge, "world: more than " + std::to_string(kMaxChunkSlots) +
+                                        " chunk slots requested"};
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+World::World() : World(WorldConfig{}) {}
+
+World::World(const WorldConfig& config) : config_(config) {
+  size_t slots = static_cast<size_t>(config.chunk_dims.x) * config.chunk_dims.y *
+                 config.chunk_dims.z;
+  kinds_.assign(slots, ChunkKind::kEmpty);
+  chunks_.resize(slots);
+}
+
+Result<World> World::create(const WorldConfig& config) {
+  Status s = check_world_config(config);
+  if (!s.ok()) return s;
+  return World(config);
+}
+
+WorldBox World::box() const {
+  return {lattice().node_position(node_min()), lattice().node_position(node_end())};
+}
+
+bool World::contains_chunk(const glm::ivec3& c) const {
+  glm::ivec3 r = c - config_.chunk_origin;
+  return r.x >= 0 && r.y >= 0 && r.z >= 0 && r.x < config_.chunk_dims.x &&
+         r.y < config_.chunk_dims.y && r.z < config_.chunk_dims.z;
+}
+
+size_t World::chunk_slot(const glm::ivec3& c) const {
+  glm::ivec3 r = c - config_.chunk_origin;
+  return (static_cast<size_t>(r.z) * config_.chunk_dims.y + r.y) * config_.chunk_dims.x + r.x;
+}
+
+glm::ivec3 World::chunk_of_node(const glm::ivec3& node) const {
+  int c = config_.chunk_size;
+  return {detail::floor_div(node.x, c), detail::floor_div(node.y, c), detail::floor_div(node.z, c)};
+}
+
+ChunkKind World::chunk_kind(const glm::ivec3& c) const {
+  return contains_chunk(c) ? kinds_[chunk_slot(c)] : ChunkKind::kEmpty;
+}
+
+const Chunk* World::chunk(const glm::ivec3& c) const {
+  return contains_chunk(c) ? chunks_[chunk_slot(c)].get() : nullptr;
+}
+
+std::shared_ptr<const Chunk> World::chunk_shared(const glm::ivec3& c) const {
+  return contains_chunk(c) ? chunks_[chunk_slot(c)] : nullptr;
+}
+
+void World::set_chunk(const glm::ivec3& c, std::shared_ptr<const Chunk> data) {
+  assert(contains_chunk(c));
+  bool inside = false;
+  if (!data || data->is_uniform(&inside)) {
+    set_uniform_chunk(c, data ? inside : false);
+    return;
+  }
+  size_t slot = chunk_slot(c);
+  kinds_[slot] = ChunkKind::kMixed;
+  chunks_[slot] = std::move(data);
+}
+
+void World::set_uniform_chunk(const glm::ivec3& c, bool solid) {
+  assert(contains_chunk(c));
+  size_t slot = chunk_slot(c);
+  kinds_[slot] = solid ? ChunkKind::kSolid : ChunkKind::kEmpty;
+  chunks_[slot].reset();
+}
+
+void World::for_each_chunk(
+    const std::function<void(const glm::ivec3&, ChunkKind, const Chunk*)>& fn) const {
+  const glm::ivec3 d = config_.chunk_dims;
+  size_t slot = 0;
+  for (int z = 0; z < d.z; ++z)
+    for (int y = 0; y < d.y; ++y)
+      for (int x = 0; x < d.x; ++x, ++slot)
+        fn(config_.chunk_origin + glm::ivec3(x, y, z), kinds_[slot], chunks_[slot].get());
+}
+
+// Start state of a ray's segment in one chunk along the axis.
+bool World::ray_starts_inside(int axis, const glm::ivec2& uv, int chunk_along) const {
+  const int c = config_.chunk_size;
+  glm::ivec3 node(0);
+  node[axis] = chunk_along * c;
+  node[axis_u(axis)] = uv.x;
+  node[axis_v(axis)] = uv.y;
+  glm::ivec3 ch = chunk_of_node(node);
+  ChunkKind kind = chunk_kind(ch);
+  if (kind != ChunkKind::kMixed) return kind == ChunkKind::kSolid;
+  int ray = detail::ray_index(node, axis, c);
+  return chunk(ch)->axis[axis].starts_inside(ray);
+}
+
+bool World::inside_node(const glm::ivec3& node) const {
+  const int c = config_.chunk_size;
+  glm::ivec3 ch = chunk_of_node(node);
+  ChunkKind kind = chunk_kind(ch);
+  if (kind != ChunkKind::kMixed) return kind == ChunkKind::kSolid;
+  const RayFamily& f = chunk(ch)->axis[0];
+  int ray = detail::ray_index(node, 0, c);
+  uint32_t node_steps = static_cast<uint32_t>(node.x - ch.x * c) * depth_steps_per_cell(c);
+  bool in = f.starts_inside(ray);
+  for (const PackedPoint& p : f.points(ray)) {
+    if (p.depth > node_steps) break;
+    in = !in;
+  }
+  return in;
+}
+
+bool World::inside(const glm::dvec3& p) const {
+  const int c = config_.chunk_size;
+  const double steps = depth_steps_per_cell(c);
+  glm::dvec3 q = lattice().to_lattice(p);
+  int votes = 0;
+  for (int a = 0; a < 3; ++a) {
+    if (!std::isfinite(q[a])) return false;
+    glm::ivec3 node;
+    node[a] = static_cast<int>(std::floor(std::clamp(q[a], -1e9, 1e9)));
+    node[axis_u(a)] = static_cast<int>(std::lround(std::clamp(q[axis_u(a)], -1e9, 1e9)));
+    node[axis_v(a)] = static_cast<int>(std::lround(std::clamp(q[axis_v(a)], -1e9, 1e9)));
+    glm::ivec3 ch = chunk_of_node(node);
+    ChunkKind kind = chunk_kind(ch);
+    bool in = kind == ChunkKind::kSolid;
+    if (kind == ChunkKind::kMixed) {
+      const RayFamily& f = chunk(ch)->axis[a];
+      int ray = detail::ray_index(node, a, c);
+      double local = (q[a] - double(ch[a]) * c) * steps;
+      in = f.starts_inside(ray);
+      for (const PackedPoint& pt : f.points(ray)) {
+        if (pt.depth > local) break;
+        in = !in;
+      }
+    }
+    votes += in ? 1 : 0;
+  }
+  return votes >= 2;
+}
+
+std::vector<SurfacePoint> World::ray_points(int axis, const glm::ivec2& uv) const {
+  std::vector<SurfacePoint> out;
+  const int c = config_.chunk_size;
+  glm::ivec3 node(0);
+  node[axis_u(axis)] = uv.x;
+  node[axis_v(axis)] = uv.y;
+  for (int k = 0; k < config_.chunk_dims[axis]; ++k) {
+    int along = config_.chunk_origin[axis] + k;
+    node[axis] = along * c;
+    glm::ivec3 ch = chunk_of_node(node);
+    const Chunk* data = chunk(ch);
+    if (!data) continue;
+    int ray = detail::ray_index(node, axis, c);
+    for (const PackedPoint& p : data->axis[axis].points(ray)) {
+      out.push_back(decode_point(p, c, along * c));
+    }
+  }
+  return out;
+}
+
+std::vector<Span> World::ray_spans(int axis, const glm::ivec2& uv) const {
+  std::vector<SurfacePoint> pts = ray_points(axis, uv);
+  std::vector<Span> spans;
+  for (size_t i = 0; i + 1 < pts.size(); ++i) {
+    if (pts[i].enter && !pts[i + 1].enter) {
+      spans.push_back({pts[i], pts[i + 1]});
+      ++i;
+    }
+  }
+  return spans;
+}
+
+namespace {
+
+// Inside length (cells) of one ray segment of a chunk.
+double segment_inside_length(const RayFamily& f, int ray, int chunk_size) {
+  const double steps = depth_steps_per_cell(chunk_size);
+  bool in = f.starts_inside(ray);
+  double last = 0.0, sum = 0.0;
+  for (const PackedPoint& p : f.points(ray)) {
+    double d = p.depth / steps;
+    if (in) sum += d - last;
+    last = d;
+    in = !in;
+  }
+  if (in) sum += chunk_size - last;
+  return sum;
+}
+
+}  // namespace
+
+double World::volume(int axis) const {
+  const int c = config_.chunk_size;
+  const double h = lattice().cell_size;
+  double cells = 0.0;
+  for (size_t slot = 0; slot < kinds_.size(); ++slot) {
+    if (kinds_[slot] == ChunkKind::kSolid) cells += double(c) * c * c;
+    if (kinds_[slot] != ChunkKind::kMixed) continue;
+    const RayFamily& f = chunks_[slot]->axis[axis];
+    for (int r = 0; r < c * c; ++r) cells += segment_inside_length(f, r, c);
+  }
+  return cells * h * h * h;
+}
+
+std::optional<WorldBox> World::solid_bounds() const {
+  const int c = config_.chunk_size;
+  glm::dvec3 lo(std::numeric_limits<double>::infinity());
+  glm::dvec3 hi(-std::numeric_limits<double>::infinity());
+  for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk* data) {
+    if (kind == ChunkKind::kSolid) {
+      lo = glm::min(lo, glm::dvec3(ch * c));
+      hi = glm::max(hi, glm::dvec3((ch + 1) * c));
+    }
+    if (!data) return;
+    for (int a = 0; a < 3; ++a) {
+      const RayFamily& f = data->axis[a];
+      for (int r = 0; r < c * c; ++r) {
+        for (const PackedPoint& p : f.points(r)) {
+          glm::dvec3 q = detail::point_lattice_position(ch, a, r, p.depth, c);
+          lo = glm::min(lo, q);
+          hi = glm::max(hi, q);
+        }
+      }
+    }
+  });
+  if (!(lo.x <= hi.x)) return std::nullopt;
+  return WorldBox{lattice().to_world(lo), lattice().to_world(hi)};
+}
+
+WorldStats World::stats() const {
+  WorldStats s;
+  s.chunks_total = kinds_.size();
+  s.memory_bytes = sizeof(World) + kinds_.capacity() * sizeof(ChunkKind) +
+                   chunks_.capacity() * sizeof(std::shared_ptr<const Chunk>);
+  const size_t rays_per_family = size_t(chunk_size()) * chunk_size();
+  for (size_t slot = 0; slot < kinds_.size(); ++slot) {
+    switch (kinds_[slot]) {
+      case ChunkKind::kEmpty: ++s.chunks_empty; break;
+      case ChunkKind::kSolid: ++s.chunks_solid; break;
+      case ChunkKind::kMixed: {
+        ++s.chunks_mixed;
+        const Chunk& ch = *chunks_[slot];
+        s.points += ch.point_count();
+        s.memory_bytes += ch.memory_bytes() + 2 * sizeof(void*);  // shared_ptr control block
+        for (const RayFamily& f : ch.axis) s.rays_stored += f.is_uniform() ? 0 : rays_per_family;
+        break;
+      }
+    }
+  }
+  s.point_bytes = s.points * sizeof(PackedPoint);
+  return s;
+}
+
+void World::set_metadata(const std::string& key, const std::string& value) {
+  for (auto& kv : metadata_) {
+    if (kv.first == key) {
+      kv.second = value;
+      return;
+    }
+  }
+  metadata_.emplace_back(key, value);
+}
+
+std::string World::metadata_value(const std::string& key) const {
+  for (const auto& kv : metadata_) {
+    if (kv.first == key) return kv.second;
+  }
+  return {};
+}
+
+}  // namespace ldc

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs the Debian packages ldc needs to build, test and benchmark.
+# Safe to run repeatedly; uses sudo when not root.
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config
+  # core
+  libtbb-dev libglm-dev libzstd-dev libstb-dev
+  # CGAL: exact predicates, mesh repair and test references
+  libcgal-dev libgmp-dev libmpfr-dev libboost-dev
+  # tool
+  libcli11-dev nlohmann-json3-dev
+  # tests, fuzzing, benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
+  # benchmark peers
+  libopenvdb-dev libboost-iostreams-dev
+)
+
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing+=("$p")
+done
+if [ "${#missing[@]}" -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages present"
+  exit 0
+fi
+echo "install-deps: installing ${missing[*]}"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,83 @@
+#include "test_util.h"
+
+#include <cmath>
+#include <map>
+
+namespace ldc::test {
+
+std::string data_path(const std::string& name) { return std::string(LDC_TEST_DATA_DIR) + "/" + name; }
+
+TriangleMesh load_test_mesh(const std::string& name) {
+  Result<TriangleMesh> m = load_mesh(data_path(name));
+  if (!m.ok()) {
+    ADD_FAILURE() << "cannot load " << name << ": " << m.status().to_string();
+    return {};
+  }
+  return std::move(m.value());
+}
+
+TriangleMesh box_mesh(const glm::dvec3& lo, const glm::dvec3& hi) {
+  TriangleMesh m;
+  for (int i = 0; i < 8; ++i) {
+    m.positions.push_back({(i & 1) ? hi.x : lo.x, (i & 2) ? hi.y : lo.y, (i & 4) ? hi.z : lo.z});
+  }
+  // Two triangles per face, counter-clockwise seen from outside.
+  const unsigned faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : faces) {
+    m.triangles.push_back({f[0], f[1], f[2]});
+    m.triangles.push_back({f[0], f[2], f[3]});
+  }
+  return m;
+}
+
+TriangleMesh sphere_mesh(const glm::dvec3& centre, double radius, int subdivisions) {
+  const double t = (1.0 + std::sqrt(5.0)) / 2.0;
+  std::vector<glm::dvec3> v = {{-1, t, 0}, {1, t, 0},  {-1, -t, 0}, {1, -t, 0},
+                               {0, -1, t}, {0, 1, t},  {0, -1, -t}, {0, 1, -t},
+                               {t, 0, -1}, {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<glm::uvec3> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
+                               {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
+                               {3, 9, 4},  {3, 4, 2},  {3, 2, 6},   {3, 6, 8},  {3, 8, 9},
+                               {4, 9, 5},  {2, 4, 11}, {6, 2, 10},  {8, 6, 7},  {9, 8, 1}};
+  for (auto& p : v) p = glm::normalize(p);
+  for (int s = 0; s < subdivisions; ++s) {
+    std::map<std::pair<unsigned, unsigned>, unsigned> mid;
+    auto midpoint = [&](unsigned a, unsigned b) {
+      auto key = std::minmax(a, b);
+      auto it = mid.find(key);
+      if (it != mid.end()) return it->second;
+      v.push_back(glm::normalize(v[a] + v[b]));
+      return mid[key] = unsigned(v.size() - 1);
+    };
+    std::vector<glm::uvec3> next;
+    for (const auto& tri : f) {
+      unsigned a = midpoint(tri[0], tri[1]), b = midpoint(tri[1], tri[2]), c = midpoint(tri[2], tri[0]);
+      next.insert(next.end(), {{tri[0], a, c}, {tri[1], b, a}, {tri[2], c, b}, {a, b, c}});
+    }
+    f = std::move(next);
+  }
+  TriangleMesh m;
+  for (const auto& p : v) m.positions.push_back(centre + radius * p);
+  m.triangles = std::move(f);
+  return m;
+}
+
+void append_mesh(TriangleMesh& a, const TriangleMesh& b) {
+  unsigned base = unsigned(a.positions.size());
+  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+  bool materials = !a.triangle_material.empty() || !b.triangle_material.empty();
+  if (materials) a.triangle_material.resize(a.triangles.size(), 0);
+  for (size_t i = 0; i < b.triangles.size(); ++i) {
+    a.triangles.push_back(b.triangles[i] + glm::uvec3(base));
+    if (materials) a.triangle_material.push_back(b.material_of(i));
+  }
+}
+
+::testing::AssertionResult is_valid(const World& world) {
+  ValidationReport r = validate(world);
+  if (r.ok) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << r.summary();
+}
+
+}  // namespace ldc::test

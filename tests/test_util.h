@@ -1,0 +1,32 @@
+// Helpers shared by the tests.
+#pragma once
+
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "ldc/mesh.h"
+#include "ldc/world.h"
+
+namespace ldc::test {
+
+// Absolute path of a file in tests/data.
+std::string data_path(const std::string& name);
+
+// Loads tests/data/<name>; fails the calling test (ADD_FAILURE) and returns an
+// empty mesh when it cannot.
+TriangleMesh load_test_mesh(const std::string& name);
+
+// Axis-aligned box [lo, hi] as 12 outward triangles.
+TriangleMesh box_mesh(const glm::dvec3& lo, const glm::dvec3& hi);
+
+// Icosphere with `subdivisions` levels (0 = icosahedron), outward.
+TriangleMesh sphere_mesh(const glm::dvec3& centre, double radius, int subdivisions);
+
+// Appends b's triangles (and positions) to a.
+void append_mesh(TriangleMesh& a, const TriangleMesh& b);
+
+// Fails the test with the report's messages unless validate() passes.
+::testing::AssertionResult is_valid(const World& world);
+
+}  // namespace ldc::test
