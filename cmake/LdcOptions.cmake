@@ -3,7 +3,8 @@ add_library(ldc_build_flags INTERFACE)
 if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
   target_compile_options(ldc_build_flags INTERFACE
     $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
-      -Wcast-align -Woverloaded-virtual -Wimplicit-fallthrough>)
+      -Wcast-align -Woverloaded-virtual -Wimplicit-fallthrough
+      -Wno-missing-field-initializers>)  # designated initializers of config structs
 endif()
 if(LDC_SANITIZE)
   target_compile_options(ldc_build_flags INTERFACE

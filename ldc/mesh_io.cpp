@@ -5,6 +5,8 @@
 // read from a header are checked against the bytes actually present before
 // anything is reserved, polygons are triangulated by one shared ear clipper,
 // and every refusal names the file plus a line (text) or byte offset (binary).
+#include "ldc/mesh.h"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -20,8 +22,6 @@
 #include <span>
 #include <stdexcept>
 #include <unordered_map>
-
-#include "ldc/mesh.h"
 
 namespace ldc {
 namespace {
@@ -461,8 +461,10 @@ class ObjParser {
   // Faces before any usemtl get "default", registered when first needed.
   uint16_t face_material() {
     if (!saw_usemtl_ && out_.mesh.material_names.empty()) {
-      (void)parse_usemtl(kDefaultMaterial);  // cannot fail: it is the first name
-      saw_usemtl_ = false;                   // so a file without usemtl still gets no materials
+      // Cannot fail: it is the first name. saw_usemtl_ goes back to false so
+      // that a file without any usemtl still ends with no materials.
+      (void)parse_usemtl(kDefaultMaterial);
+      saw_usemtl_ = false;
     }
     return current_material_;
   }

@@ -46,8 +46,8 @@ uint32_t encode_normal(const glm::dvec3& unit_normal) {
   double l1 = std::abs(n.x) + std::abs(n.y) + std::abs(n.z);
   if (!(l1 > 0.0) || !std::isfinite(l1)) n = glm::dvec3(0, 0, 1);
   glm::dvec2 p = to_oct(n);
-  // Rounding to the nearest code: at 15 bits the error stays below 0.01 degrees
-  // (tests/test_point_codec.cpp measures it), so no search among neighbours.
+  // Rounding to the nearest code: at 15 bits the error stays below 0.02 degrees
+  // (tests/test_world.cpp measures it), so no search among neighbours.
   auto quantize = [](double v) {
     return static_cast<uint32_t>(std::lround(std::clamp((v + 1.0) * 0.5 * kOctMax, 0.0, double(kOctMax))));
   };

@@ -97,8 +97,8 @@ static_assert(sizeof(PackedPoint) == 8);
 inline constexpr uint32_t kPointExitBit = 1u << 30;
 inline constexpr uint32_t kPointReservedBit = 1u << 31;
 
-// Octahedral normal code of 30 bits; the decoded normal is within 0.01 degrees
-// of the input (measured by tests/test_point_codec.cpp).
+// Octahedral normal code of 30 bits; the decoded normal is within 0.02 degrees
+// of the input (measured by tests/test_world.cpp).
 uint32_t encode_normal(const glm::dvec3& unit_normal);
 glm::vec3 decode_normal(uint32_t code);
 

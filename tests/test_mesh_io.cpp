@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <random>
@@ -906,6 +907,13 @@ TEST(LoadMesh, UnknownExtensionIsUnsupported) {
 TEST(LoadMesh, MissingFileNamesThePath) {
   EXPECT_TRUE(fails_with(load_mesh("/nonexistent/ldc/bunny.obj"), ErrorCode::kIoError,
                          "cannot open '/nonexistent/ldc/bunny.obj'"));
+}
+
+TEST(LoadMesh, DirectoryIsAnIoError) {
+  const std::string path = temp_file("directory.obj");
+  std::filesystem::create_directories(path);
+  EXPECT_TRUE(fails_with(load_mesh(path), ErrorCode::kIoError, "cannot read '" + path + "'"));
+  std::filesystem::remove(path);
 }
 
 TEST(LoadMesh, ErrorsNameThePath) {

@@ -1,1 +1,26 @@
-int main() { return 0; }
+// The ldc command-line tool: one subcommand per capability.
+#include <cstdio>
+
+#include "common.h"
+#include "ldc/io.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"ldc: Layered Depth Cube geometry kernel (format version " +
+               std::to_string(ldc::kLdcFormatVersion) + ")"};
+  app.require_subcommand(1);
+  app.fallthrough();  // global flags may follow the subcommand
+  ldc::tool::CommonOptions common;
+  app.add_flag("--json", common.json, "Machine-readable JSON on stdout");
+  app.add_flag("-q,--quiet", common.quiet, "No progress bar");
+  app.add_option("--threads", common.threads, "Worker threads (0 = all cores)");
+  ldc::tool::add_build_command(app, common);
+  ldc::tool::add_info_command(app, common);
+  ldc::tool::add_inside_command(app, common);
+  ldc::tool::add_terrain_command(app, common);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  }
+  return 0;
+}

@@ -1,0 +1,176 @@
+// Primitives, heightfields and implicit solids: exact crossings, normals, volumes.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "ldc/build.h"
+#include "test_util.h"
+
+namespace ldc {
+namespace {
+
+using test::is_valid;
+
+// Largest distance between each stored point and the primitive's exact surface,
+// with the normal error, over every point of the world.
+struct SurfaceError {
+  double max_distance = 0.0;   // m
+  double max_normal_deg = 0.0;
+  size_t points = 0;
+};
+
+SurfaceError measure(const World& w, const ImplicitSolid& solid, const glm::dvec3& centre_for_normal,
+                     bool sphere) {
+  SurfaceError e;
+  const int c = w.chunk_size();
+  w.for_each_chunk([&](const glm::ivec3& ch, ChunkKind, const Chunk* d) {
+    if (!d) return;
+    for (int a = 0; a < 3; ++a) {
+      for (int r = 0; r < c * c; ++r) {
+        glm::ivec2 uv(ch[axis_u(a)] * c + r % c, ch[axis_v(a)] * c + r / c);
+        for (const PackedPoint& p : d->axis[a].points(r)) {
+          SurfacePoint s = decode_point(p, c, ch[a] * c);
+          glm::dvec3 q;
+          q[a] = s.depth;
+          q[axis_u(a)] = uv.x;
+          q[axis_v(a)] = uv.y;
+          glm::dvec3 world = w.lattice().to_world(q);
+          e.max_distance = std::max(e.max_distance, std::abs(solid.value(world)));
+          if (sphere) {
+            glm::dvec3 exact = glm::normalize(world - centre_for_normal);
+            double deg = std::acos(std::min(1.0, glm::dot(exact, glm::dvec3(s.normal)))) * 180.0 / M_PI;
+            e.max_normal_deg = std::max(e.max_normal_deg, deg);
+          }
+          ++e.points;
+        }
+      }
+    }
+  });
+  return e;
+}
+
+TEST(Primitives, SphereCrossingsAreExactToTheDepthStep) {
+  Primitive p;
+  p.radius = 1.3;
+  p.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(0.31, -0.2, 0.05));
+  World w = build_from_primitive(p, {.cells = 64}).value();
+  EXPECT_TRUE(is_valid(w));
+  auto solid = make_primitive_solid(p);
+  SurfaceError e = measure(w, *solid, {0.31, -0.2, 0.05}, true);
+  const double h = w.lattice().cell_size;
+  EXPECT_GT(e.points, 1000u);
+  EXPECT_LT(e.max_distance, h / 1000.0);  // the depth step is h/2048
+  EXPECT_LT(e.max_normal_deg, 0.02);
+  const double v = 4.0 / 3.0 * M_PI * std::pow(1.3, 3);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(w.volume(a), v, 0.005 * v);
+}
+
+TEST(Primitives, EveryShapeUnderARotationAndScaleIsValid) {
+  glm::dmat4 m = glm::translate(glm::dmat4(1.0), glm::dvec3(1, 2, 3));
+  m = glm::rotate(m, 0.7, glm::normalize(glm::dvec3(1, 2, 3)));
+  m = glm::scale(m, glm::dvec3(1.0, 0.5, 1.5));
+  for (auto shape : {Primitive::Shape::kSphere, Primitive::Shape::kBox, Primitive::Shape::kCapsule,
+                     Primitive::Shape::kCylinder}) {
+    Primitive p;
+    p.shape = shape;
+    p.radius = 0.8;
+    p.half_height = 0.6;
+    p.half_extents = {0.7, 0.9, 0.5};
+    p.transform = m;
+    p.material = 3;
+    World w = build_from_primitive(p, {.cells = 48}).value();
+    EXPECT_TRUE(is_valid(w)) << primitive_shape_name(shape);
+    auto solid = make_primitive_solid(p);
+    SurfaceError e = measure(w, *solid, {}, false);
+    // value() is a distance in local units; the scale is at most 1.5.
+    EXPECT_LT(e.max_distance, 1.5 * w.lattice().cell_size / 1000.0) << primitive_shape_name(shape);
+    double det = glm::determinant(glm::dmat3(m));
+    double local = shape == Primitive::Shape::kSphere ? 4.0 / 3.0 * M_PI * 0.512
+                   : shape == Primitive::Shape::kBox  ? 8.0 * 0.7 * 0.9 * 0.5
+                   : shape == Primitive::Shape::kCapsule
+                       ? M_PI * 0.64 * 1.2 + 4.0 / 3.0 * M_PI * 0.512
+                       : M_PI * 0.64 * 1.2;
+    EXPECT_NEAR(w.volume(2), local * det, 0.02 * local * det) << primitive_shape_name(shape);
+    EXPECT_EQ(w.ray_points(2, {24, 24}).empty() ? 3 : w.ray_points(2, {24, 24})[0].material, 3);
+  }
+}
+
+TEST(Primitives, BoxWithFacesOnLatticePlanesKeepsNodesOnFacesOutside) {
+  Primitive p;
+  p.shape = Primitive::Shape::kBox;
+  p.half_extents = {1.0, 1.0, 1.0};
+  GridConfig g;
+  g.cell_size = 0.25;
+  g.use_origin = true;
+  g.origin = glm::dvec3(0.0);
+  World w = build_from_primitive(p, g).value();
+  EXPECT_TRUE(is_valid(w));
+  EXPECT_TRUE(w.inside_node({0, 0, 0}));
+  EXPECT_FALSE(w.inside_node({4, 0, 0}));  // on the face x = 1: value 0 is outside
+  auto spans = w.ray_spans(0, {0, 0});
+  ASSERT_EQ(spans.size(), 1u);
+  EXPECT_NEAR(spans[0].enter.depth, -4.0, 1e-3);
+  EXPECT_NEAR(spans[0].exit.depth, 4.0, 1e-3);
+}
+
+TEST(Primitives, BadParametersAreRefused) {
+  Primitive p;
+  p.radius = -1.0;
+  EXPECT_FALSE(build_from_primitive(p, {}).ok());
+  p.radius = 1.0;
+  p.transform = glm::dmat4(0.0);
+  Result<World> w = build_from_primitive(p, {});
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.status().message().find("invertible"), std::string::npos);
+}
+
+TEST(Heightfield, ZRaysCrossAtTheSurfaceHeight) {
+  auto f = [](double x, double y) { return 2.0 + 0.5 * std::sin(x) * std::cos(0.7 * y); };
+  Heightfield hf = heightfield_from_function(65, 65, 0.25, f, 0.0);
+  GridConfig g;
+  g.cell_size = 0.25;
+  g.use_origin = true;
+  g.origin = glm::dvec3(0.0);
+  World w = build_from_heightfield(hf, g).value();
+  EXPECT_TRUE(is_valid(w));
+  for (int i : {3, 17, 40}) {
+    for (int j : {5, 22, 61}) {
+      auto spans = w.ray_spans(2, {i, j});
+      ASSERT_EQ(spans.size(), 1u);
+      double z = spans[0].exit.depth * 0.25;
+      EXPECT_NEAR(z, f(i * 0.25, j * 0.25), 0.25 / 2000.0);
+      EXPECT_GT(spans[0].exit.normal.z, 0.0f);
+    }
+  }
+}
+
+TEST(Heightfield, BadFieldsAreRefused) {
+  Heightfield hf;
+  hf.width = 1;
+  hf.height = 5;
+  EXPECT_FALSE(build_from_heightfield(hf, {}).ok());
+  hf = heightfield_from_function(4, 4, 0.5, [](double, double) { return 1.0; }, 0.0);
+  hf.samples[5] = std::nanf("");
+  Result<World> w = build_from_heightfield(hf, {});
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.status().message().find("sample 5"), std::string::npos);
+  EXPECT_FALSE(load_heightfield_png("/nonexistent.png", 0.2, 1, 1, 0).ok());
+}
+
+// An implicit solid that lies about its bounds: nodes outside them are outside anyway.
+class LyingBall final : public ImplicitSolid {
+ public:
+  double value(const glm::dvec3& p) const override { return glm::length(p) - 1.0; }
+  WorldBox bounds() const override { return {glm::dvec3(-0.5), glm::dvec3(0.5)}; }
+};
+
+TEST(Implicit, SolidsBreakingTheirBoundsContractStillGiveValidWorlds) {
+  LyingBall ball;
+  World w = build_from_implicit(ball, {.cells = 16}).value();
+  EXPECT_TRUE(is_valid(w));
+}
+
+}  // namespace
+}  // namespace ldc

@@ -1,0 +1,43 @@
+// ldc info: what a .ldc file holds, and whether it is valid.
+#include <cstdio>
+#include <memory>
+
+#include "common.h"
+#include "ldc/io.h"
+
+namespace ldc::tool {
+namespace {
+
+struct InfoArgs {
+  std::string input;
+  bool no_validate = false;
+};
+
+int run_info(const InfoArgs& a, const CommonOptions& common) {
+  set_thread_count(common.threads);
+  ProgressBar bar(!common.quiet);
+  Result<World> w = load_world(a.input, {}, bar.context());
+  bar.finish();
+  if (!w.ok()) return fail("info", w.status());
+  nlohmann::json info = world_info_json(w.value(), !a.no_validate);
+  info["file"] = a.input;
+  if (common.json) std::printf("%s\n", info.dump(2).c_str());
+  else std::printf("file        %s\n%s", a.input.c_str(), world_info_text(info).c_str());
+  if (!a.no_validate && !info["validation"]["ok"].get<bool>()) return 2;
+  return 0;
+}
+
+}  // namespace
+
+void add_info_command(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<InfoArgs>();
+  CLI::App* cmd = app.add_subcommand("info", "Chunks, rays, points, memory, repairs and validation of a .ldc file");
+  cmd->add_option("input", args->input, ".ldc file")->required();
+  cmd->add_flag("--no-validate", args->no_validate, "Skip the full invariant check");
+  cmd->callback([args, &common] {
+    int code = run_info(*args, common);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ldc::tool

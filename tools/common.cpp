@@ -1,0 +1,134 @@
+#include "common.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include <tbb/global_control.h>
+
+namespace ldc::tool {
+
+ProgressBar::ProgressBar(bool enabled)
+    : enabled_(enabled), tty_(isatty(STDERR_FILENO)), start_(std::chrono::steady_clock::now()) {
+  if (!enabled_) return;
+  ctx_.set_progress([this](std::string_view stage, double fraction) { draw(stage, fraction); });
+}
+
+ProgressBar::~ProgressBar() { finish(); }
+
+void ProgressBar::draw(std::string_view stage, double fraction) {
+  double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  if (elapsed < 1.0) return;  // short work gets no bar
+  int decile = int(fraction * 10.0);
+  if (!tty_ && stage == last_stage_ && decile == last_decile_) return;
+  last_stage_ = std::string(stage);
+  last_decile_ = decile;
+  const int width = 30;
+  int filled = int(std::lround(fraction * width));
+  std::string bar(size_t(filled), '#');
+  bar.resize(width, '.');
+  std::fprintf(stderr, "%s%-10.*s [%s] %3d%%  %.1fs%s", tty_ ? "\r" : "", int(stage.size()),
+               stage.data(), bar.c_str(), int(fraction * 100.0), elapsed, tty_ ? "" : "\n");
+  std::fflush(stderr);
+  drawn_ = true;
+}
+
+void ProgressBar::finish() {
+  if (drawn_ && tty_) std::fprintf(stderr, "\n");
+  drawn_ = false;
+}
+
+int fail(const std::string& command, const Status& status) {
+  return fail(command, status.to_string());
+}
+
+int fail(const std::string& command, const std::string& message) {
+  std::fprintf(stderr, "ldc %s: %s\n", command.c_str(), message.c_str());
+  return 1;
+}
+
+bool parse_vec3(const std::string& text, glm::dvec3* out) {
+  std::istringstream in(text);
+  char c1 = 0, c2 = 0;
+  glm::dvec3 v;
+  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',') return false;
+  std::string rest;
+  if (in >> rest) return false;
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return false;
+  *out = v;
+  return true;
+}
+
+nlohmann::json world_info_json(const World& world, bool run_validate) {
+  nlohmann::json j;
+  const WorldStats s = world.stats();
+  const Lattice& lat = world.lattice();
+  j["lattice"] = {{"origin", {lat.origin.x, lat.origin.y, lat.origin.z}}, {"cell_size", lat.cell_size}};
+  j["chunk_size"] = world.chunk_size();
+  glm::ivec3 d = world.chunk_dims(), o = world.chunk_origin();
+  j["chunk_box"] = {{"origin", {o.x, o.y, o.z}}, {"dims", {d.x, d.y, d.z}}};
+  j["chunks"] = {{"total", s.chunks_total}, {"empty", s.chunks_empty}, {"solid", s.chunks_solid},
+                 {"mixed", s.chunks_mixed}};
+  j["rays_stored"] = s.rays_stored;
+  j["points"] = s.points;
+  j["bytes_per_point_record"] = sizeof(PackedPoint);
+  j["memory_bytes"] = s.memory_bytes;
+  j["bytes_per_point"] = s.bytes_per_point();
+  j["volume_m3"] = {world.volume(0), world.volume(1), world.volume(2)};
+  if (auto b = world.solid_bounds()) {
+    j["solid_bounds"] = {{"min", {b->min.x, b->min.y, b->min.z}}, {"max", {b->max.x, b->max.y, b->max.z}}};
+  }
+  nlohmann::json meta = nlohmann::json::object();
+  for (const auto& [k, v] : world.metadata()) meta[k] = v;
+  j["metadata"] = meta;
+  if (run_validate) {
+    ValidationReport r = validate(world);
+    j["validation"] = {{"ok", r.ok}, {"errors", r.errors}, {"nodes_checked", r.nodes_checked},
+                       {"messages", r.messages}};
+  }
+  return j;
+}
+
+std::string world_info_text(const nlohmann::json& j) {
+  std::ostringstream s;
+  s.precision(6);
+  auto v3 = [](const nlohmann::json& a) {
+    std::ostringstream o;
+    o << a[0].get<double>() << ", " << a[1].get<double>() << ", " << a[2].get<double>();
+    return o.str();
+  };
+  s << "lattice     origin (" << v3(j["lattice"]["origin"]) << "), cell size "
+    << j["lattice"]["cell_size"].get<double>() << " m\n";
+  s << "chunks      " << j["chunks"]["total"] << " of " << j["chunk_size"] << "^3 cells: "
+    << j["chunks"]["empty"] << " empty, " << j["chunks"]["solid"] << " solid, "
+    << j["chunks"]["mixed"] << " mixed\n";
+  s << "rays        " << j["rays_stored"] << " stored\n";
+  s << "points      " << j["points"] << " (" << j["bytes_per_point_record"] << " bytes each)\n";
+  s << "memory      " << j["memory_bytes"].get<size_t>() / 1024 << " KiB, "
+    << j["bytes_per_point"].get<double>() << " bytes per point all-in\n";
+  s << "volume      " << v3(j["volume_m3"]) << " m^3 (from x, y, z spans)\n";
+  if (j.contains("solid_bounds")) {
+    s << "solid       (" << v3(j["solid_bounds"]["min"]) << ") .. (" << v3(j["solid_bounds"]["max"]) << ")\n";
+  }
+  for (const auto& [k, v] : j["metadata"].items()) s << "  " << k << ": " << v.get<std::string>() << "\n";
+  if (j.contains("validation")) {
+    const auto& v = j["validation"];
+    s << "validation  " << (v["ok"].get<bool>() ? "valid" : "INVALID") << " (" << v["errors"]
+      << " errors, " << v["nodes_checked"] << " nodes checked across axes)\n";
+    for (const auto& m : v["messages"]) s << "  " << m.get<std::string>() << "\n";
+  }
+  return s.str();
+}
+
+void set_thread_count(int threads) {
+  static std::unique_ptr<tbb::global_control> control;
+  if (threads > 0) {
+    control = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                    size_t(threads));
+  }
+}
+
+}  // namespace ldc::tool

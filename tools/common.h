@@ -1,0 +1,67 @@
+// Shared pieces of the ldc command-line tool: progress bar, errors, JSON output.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include "ldc/build.h"
+#include "ldc/context.h"
+#include "ldc/status.h"
+#include "ldc/world.h"
+
+namespace ldc::tool {
+
+// Options every command shares.
+struct CommonOptions {
+  bool json = false;       // machine-readable output on stdout
+  bool quiet = false;      // no progress bar
+  int threads = 0;         // 0 = all cores
+};
+
+// A Context whose progress callback draws a bar on stderr once the work has
+// taken more than a second (redrawn in place on a terminal, one line per 10%
+// otherwise).
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled);
+  ~ProgressBar();
+  Context* context() { return &ctx_; }
+  void finish();
+
+ private:
+  void draw(std::string_view stage, double fraction);
+  Context ctx_;
+  bool enabled_;
+  bool tty_;
+  bool drawn_ = false;
+  int last_decile_ = -1;
+  std::string last_stage_;
+  std::chrono::steady_clock::time_point start_;
+};
+
+// Prints "ldc <command>: <message>" on stderr; returns the exit status for it.
+int fail(const std::string& command, const Status& status);
+int fail(const std::string& command, const std::string& message);
+
+// "1,2,3" -> vector; false when malformed.
+bool parse_vec3(const std::string& text, glm::dvec3* out);
+
+// The world's statistics and validation as JSON (what `ldc info --json` prints).
+nlohmann::json world_info_json(const World& world, bool run_validate);
+// The same, as human-readable lines.
+std::string world_info_text(const nlohmann::json& info);
+
+// Limits the TBB worker threads for the rest of the process (0 = all).
+void set_thread_count(int threads);
+
+// Registers the subcommands.
+void add_build_command(CLI::App& app, CommonOptions& common);
+void add_info_command(CLI::App& app, CommonOptions& common);
+void add_inside_command(CLI::App& app, CommonOptions& common);
+void add_terrain_command(CLI::App& app, CommonOptions& common);
+
+}  // namespace ldc::tool
