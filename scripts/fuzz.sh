@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Builds the libFuzzer targets with clang and runs each for a bounded time.
+# Usage: scripts/fuzz.sh [seconds per target, default 60]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+seconds=${1:-60}
+CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DLDC_BUILD_FUZZERS=ON -DLDC_BUILD_TESTS=OFF -DLDC_BUILD_TOOLS=OFF >/dev/null
+cmake --build build-fuzz -j "$(nproc 2>/dev/null || echo 2)"
+for target in fuzz_ldc_load fuzz_mesh_parsers; do
+  corpus=$(mktemp -d)
+  cp fuzz/corpus/${target#fuzz_}/* "$corpus"/ 2>/dev/null || true
+  echo "fuzzing $target for ${seconds}s"
+  ./build-fuzz/fuzz/$target "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
+    -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 2>&1 | tail -n 12
+  rm -rf "$corpus"
+done

@@ -1,0 +1,111 @@
+// Agreement with CGAL, the exact reference: inside/outside at lattice nodes
+// (Side_of_triangle_mesh) and the volume of the open bunny against the same
+// bunny with its holes filled by CGAL's triangulate_hole.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include <CGAL/AABB_face_graph_triangle_primitive.h>
+#include <CGAL/AABB_traits.h>
+#include <CGAL/AABB_tree.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/measure.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
+#include <CGAL/Side_of_triangle_mesh.h>
+#include <CGAL/Surface_mesh.h>
+
+#include "ldc/build.h"
+#include "test_util.h"
+
+namespace ldc {
+namespace {
+
+using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Point = Kernel::Point_3;
+using Mesh = CGAL::Surface_mesh<Point>;
+namespace PMP = CGAL::Polygon_mesh_processing;
+
+Mesh to_cgal(const TriangleMesh& m) {
+  Mesh out;
+  std::vector<Mesh::Vertex_index> v;
+  for (const auto& p : m.positions) v.push_back(out.add_vertex(Point(p.x, p.y, p.z)));
+  for (const auto& t : m.triangles) out.add_face(v[t[0]], v[t[1]], v[t[2]]);
+  return out;
+}
+
+// At least 100,000 random lattice nodes inside the mesh's bounding box, leaving
+// out those within 1e-6 of the diagonal from the surface.
+void expect_nodes_agree_with_cgal(const char* name, int cells) {
+  TriangleMesh m = test::load_test_mesh(name);
+  Mesh cm = to_cgal(m);
+  ASSERT_TRUE(CGAL::is_closed(cm)) << name;
+  World w = build_from_mesh(m, {.cells = cells}).value();
+  CGAL::Side_of_triangle_mesh<Mesh, Kernel> side(cm);
+  using Primitive = CGAL::AABB_face_graph_triangle_primitive<Mesh>;
+  CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>> tree(faces(cm).first, faces(cm).second, cm);
+  tree.accelerate_distance_queries();
+  MeshBounds b = mesh_bounds(m);
+  const double near = 1e-6 * b.diagonal();
+  glm::ivec3 lo = glm::ivec3(glm::floor(w.lattice().to_lattice(b.min)));
+  glm::ivec3 hi = glm::ivec3(glm::ceil(w.lattice().to_lattice(b.max)));
+  std::mt19937 rng(42);
+  size_t checked = 0, agree = 0, inside = 0, skipped = 0;
+  while (checked < 100000) {
+    glm::ivec3 n(lo.x + int(rng() % (hi.x - lo.x + 1)), lo.y + int(rng() % (hi.y - lo.y + 1)),
+                 lo.z + int(rng() % (hi.z - lo.z + 1)));
+    glm::dvec3 p = w.lattice().node_position(n);
+    Point q(p.x, p.y, p.z);
+    if (tree.squared_distance(q) < near * near) {
+      ++skipped;
+      continue;
+    }
+    bool cgal_in = side(q) == CGAL::ON_BOUNDED_SIDE;
+    bool ours = w.inside_node(n);
+    ++checked;
+    agree += cgal_in == ours;
+    inside += cgal_in;
+  }
+  EXPECT_EQ(agree, checked) << name << ": " << checked - agree << " of " << checked
+                            << " nodes disagree (" << inside << " inside, " << skipped << " skipped)";
+  EXPECT_GT(inside, checked / 20) << name << ": too few inside samples to mean anything";
+}
+
+TEST(CgalReference, InsideAgreesWithSideOfTriangleMeshOnSpot) { expect_nodes_agree_with_cgal("spot.obj", 128); }
+TEST(CgalReference, InsideAgreesWithSideOfTriangleMeshOnFandisk) { expect_nodes_agree_with_cgal("fandisk.obj", 128); }
+TEST(CgalReference, InsideAgreesWithSideOfTriangleMeshOnRockerArm) { expect_nodes_agree_with_cgal("rocker-arm.obj", 128); }
+
+TEST(CgalReference, OpenBunnyVolumeWithinTwoPercentOfTheHoleFilledBunny) {
+  TriangleMesh m = test::load_test_mesh("stanford-bunny.obj");
+  Mesh cm = to_cgal(m);
+  int holes = 0;
+  std::vector<Mesh::Halfedge_index> borders;
+  for (auto h : halfedges(cm)) {
+    if (cm.is_border(h)) borders.push_back(h);
+  }
+  std::set<Mesh::Halfedge_index> seen;
+  for (auto h : borders) {
+    if (seen.count(h) || !cm.is_border(h)) continue;
+    for (auto g : CGAL::halfedges_around_face(h, cm)) seen.insert(g);
+    std::vector<Mesh::Face_index> added;
+    PMP::triangulate_hole(cm, h, std::back_inserter(added));
+    ++holes;
+  }
+  ASSERT_TRUE(CGAL::is_closed(cm));
+  EXPECT_EQ(holes, 5);
+  const double reference = PMP::volume(cm);
+  for (int cells : {128, 256}) {
+    BuildReport r;
+    World w = build_from_mesh(m, {.cells = cells}, nullptr, &r).value();
+    EXPECT_TRUE(test::is_valid(w));
+    for (int a = 0; a < 3; ++a) {
+      EXPECT_NEAR(w.volume(a), reference, 0.02 * reference)
+          << "axis " << a << " at " << cells << " cells (" << r.repaired_rays << " repaired rays)";
+    }
+    std::printf("bunny at %d cells: volume %.6g %.6g %.6g vs filled %.6g (%.2f%%), %zu repaired rays\n",
+                cells, w.volume(0), w.volume(1), w.volume(2), reference,
+                100.0 * (w.volume(0) - reference) / reference, r.repaired_rays);
+  }
+}
+
+}  // namespace
+}  // namespace ldc
