@@ -97,6 +97,10 @@ int main(int argc, char** argv) {
   ldc::bench::print_machine();
   std::vector<int> resolutions = args.quick ? std::vector<int>{64, 128} : std::vector<int>{64, 128, 256, 512};
   std::vector<Row> rows;
+  if (args.accuracy_only) {
+    ldc::bench::print_accuracy(args, {128, 256});
+    return 0;
+  }
   for (const std::string& name : args.meshes) {
     ldc::TriangleMesh mesh = ldc::bench::load(args, name);
     VdbInput vin = to_vdb(mesh);

@@ -17,13 +17,14 @@ Args parse_args(int argc, char** argv, std::vector<std::string> default_meshes) 
   for (int i = 1; i < argc; ++i) {
     std::string s = argv[i];
     if (s == "--quick") a.quick = true;
+    else if (s == "--accuracy") a.accuracy_only = true;
     else if (s == "--data" && i + 1 < argc) a.data_dir = argv[++i];
     else if (s == "--meshes" && i + 1 < argc) {
       a.meshes.clear();
       std::stringstream in(argv[++i]);
       for (std::string m; std::getline(in, m, ',');) a.meshes.push_back(m);
     } else {
-      std::fprintf(stderr, "usage: %s [--quick] [--data DIR] [--meshes a.obj,b.obj]\n", argv[0]);
+      std::fprintf(stderr, "usage: %s [--quick] [--accuracy] [--data DIR] [--meshes a.obj,b.obj]\n", argv[0]);
       std::exit(2);
     }
   }

@@ -13,6 +13,7 @@ namespace ldc::bench {
 
 struct Args {
   bool quick = false;               // fewer resolutions and repetitions
+  bool accuracy_only = false;       // skip the timing tables
   std::string data_dir;             // where the meshes are
   std::vector<std::string> meshes;  // file names in data_dir
 };

@@ -49,8 +49,12 @@ Status snap_vertices(const TriangleMesh& mesh, const Lattice& lat, SnappedMesh& 
                      [&](uint32_t a, uint32_t b) { return fixed[a] < fixed[b]; });
   welded_id.assign(n, 0);
   out.vertices.clear();
+  out.unsnapped.clear();
   for (size_t k = 0; k < n; ++k) {
-    if (k == 0 || fixed[order[k]] != fixed[order[k - 1]]) out.vertices.push_back(fixed[order[k]]);
+    if (k == 0 || fixed[order[k]] != fixed[order[k - 1]]) {
+      out.vertices.push_back(fixed[order[k]]);
+      out.unsnapped.push_back((mesh.positions[order[k]] - lat.origin) * scale);
+    }
     welded_id[order[k]] = uint32_t(out.vertices.size() - 1);
   }
   return {};

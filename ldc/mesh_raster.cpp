@@ -144,11 +144,12 @@ void bin_triangles(const Shared& sh, AxisTiles& at) {
 // Stage 2: rasterize one triangle into one tile
 
 struct TriangleSetup {
-  Vec3i p[3];             // vertices as (w, u, v)
+  Vec3i p[3];             // snapped vertices as (w, u, v)
   i128 n_w, n_u, n_v;     // exact normal in (w, u, v)
   i128 n_xyz[3];
-  double nw, nu, nv;
   int sign_o;             // sign of the projected orientation (= sign of n_w)
+  glm::dvec3 a_in;        // first vertex before snapping, as (w, u, v)
+  glm::dvec3 n_in;        // normal before snapping, as (w, u, v)
 };
 
 TriangleSetup setup_triangle(const SnappedMesh& m, uint32_t t, int a) {
@@ -163,31 +164,47 @@ TriangleSetup setup_triangle(const SnappedMesh& m, uint32_t t, int a) {
   s.n_w = n[a];
   s.n_u = n[u];
   s.n_v = n[v];
-  s.nw = double(s.n_w);
-  s.nu = double(s.n_u);
-  s.nv = double(s.n_v);
   s.sign_o = sign_of(s.n_w);
+  const auto& tri = m.triangles[t];
+  glm::dvec3 p0 = m.unsnapped[tri[0]], p1 = m.unsnapped[tri[1]], p2 = m.unsnapped[tri[2]];
+  glm::dvec3 ni = glm::cross(p1 - p0, p2 - p0);
+  s.a_in = {p0[a], p0[u], p0[v]};
+  s.n_in = {ni[a], ni[u], ni[v]};
   return s;
 }
 
-// Quantized depth of the crossing at ray (ru, rv) (node coordinates), moved
-// off a node by one step to the side the exact predicate says.
+// Depth (fixed-point units) where the ray (ru, rv) meets the plane through a
+// with normal n, both as (w, u, v); NaN when the plane is parallel to the ray.
+double plane_depth(const glm::dvec3& a, const glm::dvec3& n, int64_t ru, int64_t rv) {
+  double du = double(ru * kFixedOne) - a.y, dv = double(rv * kFixedOne) - a.z;
+  return n.x != 0.0 ? a.x - (n.y * du + n.z * dv) / n.x : std::nan("");
+}
+
+// Quantized depth of the crossing at ray (ru, rv) (node coordinates). The cell
+// it falls in is decided on the snapped triangle, exactly: a crossing that
+// rounds onto a node moves one step to the side the exact predicate says.
+// Within that cell the depth comes from the unsnapped triangle.
 int64_t crossing_depth(const TriangleSetup& s, int64_t ru, int64_t rv, uint32_t q,
                        size_t& nudged) {
   const Vec3i& A = s.p[0];
-  double du = double(ru * kFixedOne - A[1]);
-  double dv = double(rv * kFixedOne - A[2]);
-  double t_fixed = double(A[0]) - (s.nu * du + s.nv * dv) / s.nw;
-  int64_t d = std::llround(t_fixed * (double(q) / double(kFixedOne)));
-  if (floor_div64(d, q) * int64_t(q) != d) return d;
-  // On a node: before or after it, exactly? The node is after the crossing when
-  // the plane value at the (perturbed) node has the sign of n_w.
-  int64_t node_w = (d / int64_t(q)) * kFixedOne;
-  i128 plane = s.n_w * i128(node_w - A[0]) + s.n_u * i128(ru * kFixedOne - A[1]) +
-               s.n_v * i128(rv * kFixedOne - A[2]);
-  int side = perturbed_plane_sign(plane, s.n_xyz[0], s.n_xyz[1], s.n_xyz[2]);
-  ++nudged;
-  return side == s.sign_o ? d - 1 : d + 1;
+  glm::dvec3 a_snapped{static_cast<double>(A[0]), static_cast<double>(A[1]), static_cast<double>(A[2])};
+  glm::dvec3 n_snapped{static_cast<double>(s.n_w), static_cast<double>(s.n_u), static_cast<double>(s.n_v)};
+  const double scale = double(q) / double(kFixedOne);
+  int64_t d = std::llround(plane_depth(a_snapped, n_snapped, ru, rv) * scale);
+  if (floor_div64(d, q) * int64_t(q) == d) {
+    // On a node: the node is after the crossing when the plane value at the
+    // (perturbed) node has the sign of n_w.
+    int64_t node_w = (d / int64_t(q)) * kFixedOne;
+    i128 plane = s.n_w * i128(node_w - A[0]) + s.n_u * i128(ru * kFixedOne - A[1]) +
+                 s.n_v * i128(rv * kFixedOne - A[2]);
+    int side = perturbed_plane_sign(plane, s.n_xyz[0], s.n_xyz[1], s.n_xyz[2]);
+    ++nudged;
+    d = side == s.sign_o ? d - 1 : d + 1;
+  }
+  double t_in = plane_depth(s.a_in, s.n_in, ru, rv);
+  if (!std::isfinite(t_in)) return d;
+  const int64_t cell = floor_div64(d, q) * int64_t(q);
+  return std::clamp<int64_t>(std::llround(t_in * scale), cell + 1, cell + int64_t(q) - 1);
 }
 
 // Edge function E(R) = du*(R.v - P.v) - dv*(R.u - P.u), turned so that inside

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <glm/glm.hpp>
+
 #include "ldc/build.h"
 #include "ldc/detail/exact.h"
 #include "ldc/world.h"
@@ -16,6 +18,10 @@ using Vec3i = std::array<int64_t, 3>;
 // Vertices in fixed-point lattice coordinates, welded; non-degenerate triangles only.
 struct SnappedMesh {
   std::vector<Vec3i> vertices;
+  // The input positions of the welded vertices in the same fixed-point units,
+  // before rounding: depths are computed from these (snapping moves a crossing
+  // far along a ray that grazes the surface), decisions from `vertices`.
+  std::vector<glm::dvec3> unsnapped;
   std::vector<std::array<uint32_t, 3>> triangles;
   std::vector<uint16_t> material;
   std::vector<uint32_t> normal_code;   // outward (as wound) normal, octahedral
