@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include <glm/gtc/matrix_transform.hpp>
+#include <stb_image_write.h>
 
 #include "ldc/build.h"
 #include "test_util.h"
@@ -170,6 +171,64 @@ TEST(Implicit, SolidsBreakingTheirBoundsContractStillGiveValidWorlds) {
   LyingBall ball;
   World w = build_from_implicit(ball, {.cells = 16}).value();
   EXPECT_TRUE(is_valid(w));
+}
+
+}  // namespace
+}  // namespace ldc
+
+namespace ldc {
+namespace {
+
+TEST(Heightfield, GrayscalePngLoadsAndBuilds) {
+  // A 16 x 8 ramp along x, written with stb and read back through the loader.
+  std::vector<unsigned char> pixels(16 * 8);
+  for (int j = 0; j < 8; ++j)
+    for (int i = 0; i < 16; ++i) pixels[j * 16 + i] = static_cast<unsigned char>(i * 17);
+  std::string path = ::testing::TempDir() + "/ramp.png";
+  ASSERT_NE(stbi_write_png(path.c_str(), 16, 8, 1, pixels.data(), 16), 0);
+  Result<Heightfield> hf = load_heightfield_png(path, 0.5, 3.0, 1.0, 0.0);
+  ASSERT_TRUE(hf.ok()) << hf.status().to_string();
+  EXPECT_EQ(hf.value().width, 16);
+  EXPECT_FLOAT_EQ(hf.value().samples[15], 1.0f);
+  GridConfig g;
+  g.cell_size = 0.25;
+  g.use_origin = true;
+  g.origin = glm::dvec3(0.125);  // rays through cell centres of the footprint: a midpoint rule
+  World w = build_from_heightfield(hf.value(), g).value();
+  EXPECT_TRUE(is_valid(w));
+  // Solid volume: 7.5 m x 3.5 m footprint under a ramp from 1 m to 4 m: mean height 2.5 m.
+  EXPECT_NEAR(w.volume(2), 7.5 * 3.5 * 2.5, 0.03 * 7.5 * 3.5 * 2.5);
+  EXPECT_FALSE(load_heightfield_png(::testing::TempDir() + "/missing.png", 0.5, 1, 1, 0).ok());
+}
+
+TEST(BuildProgress, ReportsFractionsUpToOne) {
+  Context ctx;
+  double last = 0.0;
+  bool monotone = true;
+  ctx.set_progress([&](std::string_view, double f) {
+    monotone = monotone && f >= 0.0 && f <= 1.0;
+    last = f;
+  });
+  Primitive p;
+  ASSERT_TRUE(build_from_primitive(p, {.cells = 64, .chunk_size = 8}, &ctx).ok());
+  EXPECT_TRUE(monotone);
+  EXPECT_DOUBLE_EQ(last, 1.0);
+  EXPECT_GT(ctx.timers().count("build"), 0u);
+}
+
+TEST(Inside, ArbitraryPointsMatchNodesAndTheShape) {
+  Primitive p;
+  p.radius = 1.0;
+  World w = build_from_primitive(p, {.cells = 64}).value();
+  const double h = w.lattice().cell_size;
+  for (int i = 0; i < 2000; ++i) {
+    glm::dvec3 q(std::sin(i * 1.7) * 1.2, std::cos(i * 2.3) * 1.2, std::sin(i * 0.37) * 1.2);
+    double r = glm::length(q);
+    if (std::abs(r - 1.0) < 2.0 * h) continue;  // near the surface the lattice decides
+    EXPECT_EQ(w.inside(q), r < 1.0) << q.x << " " << q.y << " " << q.z;
+  }
+  EXPECT_FALSE(w.inside({std::nan(""), 0, 0}));
+  EXPECT_FALSE(w.inside({1e300, 0, 0}));
 }
 
 }  // namespace
