@@ -34,7 +34,7 @@ bool same_world(const World& a, const World& b) {
       for (int r = 0; r < c * c; ++r) {
         auto pa = d->axis[ax].points(r), pb = b.chunk(ch)->axis[ax].points(r);
         same = same && d->axis[ax].starts_inside(r) == b.chunk(ch)->axis[ax].starts_inside(r) &&
-               pa.size() == pb.size() && std::memcmp(pa.data(), pb.data(), pa.size_bytes()) == 0;
+               pa.size() == pb.size() && (pa.empty() || std::memcmp(pa.data(), pb.data(), pa.size_bytes()) == 0);
       }
     }
   });
