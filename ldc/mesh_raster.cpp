@@ -19,6 +19,7 @@ void SnappedMesh::resize(size_t n) {
   material.resize(n);
   normal_code.resize(n);
   normal_positive.resize(n);
+  box.resize(n);
 }
 
 void SnappedMesh::set_triangle(size_t i, const std::array<uint32_t, 3>& t,
@@ -28,6 +29,11 @@ void SnappedMesh::set_triangle(size_t i, const std::array<uint32_t, 3>& t,
   glm::dvec3 nd{static_cast<double>(n[0]), static_cast<double>(n[1]), static_cast<double>(n[2])};
   normal_code[i] = encode_normal(glm::normalize(nd));
   normal_positive[i] = uint8_t((n[0] > 0) | ((n[1] > 0) << 1) | ((n[2] > 0) << 2));
+  for (int a = 0; a < 3; ++a) {
+    int64_t p0 = vertices[t[0]][a], p1 = vertices[t[1]][a], p2 = vertices[t[2]][a];
+    box[i][a] = std::min(p0, std::min(p1, p2));
+    box[i][a + 3] = std::max(p0, std::max(p1, p2));
+  }
 }
 
 std::array<i128, 3> triangle_normal(const std::vector<Vec3i>& v, const std::array<uint32_t, 3>& t) {
@@ -95,16 +101,9 @@ struct NodeRange {
 };
 
 NodeRange triangle_node_range(const SnappedMesh& m, uint32_t t, int u, int v) {
-  const auto& tri = m.triangles[t];
-  int64_t mu = INT64_MAX, Mu = INT64_MIN, mv = INT64_MAX, Mv = INT64_MIN;
-  for (uint32_t i : tri) {
-    mu = std::min(mu, m.vertices[i][u]);
-    Mu = std::max(Mu, m.vertices[i][u]);
-    mv = std::min(mv, m.vertices[i][v]);
-    Mv = std::max(Mv, m.vertices[i][v]);
-  }
-  return {ceil_div64(mu, kFixedOne), floor_div64(Mu, kFixedOne), ceil_div64(mv, kFixedOne),
-          floor_div64(Mv, kFixedOne)};
+  const auto& b = m.box[t];
+  return {ceil_div64(b[u], kFixedOne), floor_div64(b[u + 3], kFixedOne), ceil_div64(b[v], kFixedOne),
+          floor_div64(b[v + 3], kFixedOne)};
 }
 
 // Bins triangles into the chunk columns of one axis (CSR).

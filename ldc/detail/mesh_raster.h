@@ -26,6 +26,7 @@ struct SnappedMesh {
   std::vector<uint16_t> material;
   std::vector<uint32_t> normal_code;   // outward (as wound) normal, octahedral
   std::vector<uint8_t> normal_positive;  // bit a: normal component a > 0
+  std::vector<std::array<int64_t, 6>> box;  // min x, y, z, max x, y, z of each triangle
 
   void resize(size_t n);
   // Sets triangle i; safe to call for different i from several threads.
