@@ -202,4 +202,14 @@ Result<World> build_from_implicit(const ImplicitSolid& solid, const GridConfig& 
   }
 }
 
+namespace detail {
+
+Result<World> build_implicit_as(const ImplicitSolid& solid, const GridConfig& grid, Context* ctx,
+                                BuildReport* report, const std::string& source) {
+  Result<World> w = build_from_implicit(solid, grid, ctx, report);
+  if (w.ok()) w.value().set_metadata("source", source);
+  return w;
+}
+
+}  // namespace detail
 }  // namespace ldc

@@ -6,6 +6,7 @@
 #include <stb_image.h>
 
 #include "ldc/build.h"
+#include "ldc/detail/build_common.h"
 
 namespace ldc {
 namespace {
@@ -187,10 +188,7 @@ Result<World> build_from_heightfield(const Heightfield& field, const GridConfig&
                                      Context* ctx, BuildReport* report) {
   Status s = check_heightfield(field);
   if (!s.ok()) return s;
-  auto solid = make_heightfield_solid(field);
-  Result<World> w = build_from_implicit(*solid, grid, ctx, report);
-  if (w.ok()) w.value().set_metadata("source", "heightfield");
-  return w;
+  return detail::build_implicit_as(*make_heightfield_solid(field), grid, ctx, report, "heightfield");
 }
 
 }  // namespace ldc

@@ -7,6 +7,7 @@
 #include <utility>
 
 #include "ldc/build.h"
+#include "ldc/detail/build_common.h"
 
 namespace ldc {
 
@@ -243,10 +244,8 @@ Result<World> build_from_primitive(const Primitive& primitive, const GridConfig&
                                    Context* ctx, BuildReport* report) {
   Status s = check_primitive(primitive);
   if (!s.ok()) return s;
-  auto solid = make_primitive_solid(primitive);
-  Result<World> w = build_from_implicit(*solid, grid, ctx, report);
-  if (w.ok()) w.value().set_metadata("source", std::string("primitive ") + primitive_shape_name(primitive.shape));
-  return w;
+  return detail::build_implicit_as(*make_primitive_solid(primitive), grid, ctx, report,
+                                   std::string("primitive ") + primitive_shape_name(primitive.shape));
 }
 
 }  // namespace ldc

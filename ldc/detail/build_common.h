@@ -65,6 +65,10 @@ inline glm::ivec3 slot_chunk(const World& w, size_t slot) {
   return w.chunk_origin() + glm::ivec3(x, y, z);
 }
 
+// build_from_implicit, then the world's "source" metadata set to `source`.
+Result<World> build_implicit_as(const ImplicitSolid& solid, const GridConfig& grid, Context* ctx,
+                                BuildReport* report, const std::string& source);
+
 // Writes the build report's figures into the world's metadata.
 void record_build_report(World& world, const BuildReport& report);
 
