@@ -653,8 +653,8 @@ struct FamilyTarget {
   std::vector<uint8_t> next;
 };
 
-void family_target(const Shared& sh, int a, const glm::ivec3& ch, const ChunkVotes& here,
-                   const ChunkVotes* ahead, FamilyTarget& t) {
+void family_target(const Shared& sh, int a, const ChunkVotes& here, const ChunkVotes* ahead,
+                   FamilyTarget& t) {
   const int c = sh.c;
   const uint64_t ones = c == 64 ? ~uint64_t{0} : (uint64_t{1} << c) - 1;
   t.words.assign(size_t(c) * c, here.value ? ones : 0);
@@ -667,7 +667,6 @@ void family_target(const Shared& sh, int a, const glm::ivec3& ch, const ChunkVot
     local[axis_v(a)] = r / c;
     t.next[r] = ahead->node(local);
   }
-  (void)ch;
 }
 
 RayFamily emit_family(const Shared& sh, int a, const TileRaw& raw, const ColumnCursor& cur,
@@ -735,7 +734,7 @@ void emit_tile(const Shared& sh, TileSet& ts, int a, size_t tile, ChunkAssembly&
     // Votes that equal this axis's own labelling here and at the next chunk's
     // first nodes leave its rays as they are.
     bool needs_target = here && !((here->agrees >> a) & 1u && (!ahead || (ahead->agrees >> a) & 1u));
-    if (needs_target) family_target(sh, a, ch, *here, ahead, target);
+    if (needs_target) family_target(sh, a, *here, ahead, target);
     assembly.families(slot)[a] =
         emit_family(sh, a, raw, cur, start, needs_target ? &target : nullptr, raw.repaired, counts);
   }
