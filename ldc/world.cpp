@@ -38,15 +38,18 @@ bool RayFamily::starts_inside(int ray) const {
   return (inside_[static_cast<size_t>(ray) >> 6] >> (ray & 63)) & 1u;
 }
 
+uint32_t RayFamily::first_point(int ray) const {
+  if (is_uniform()) return 0;
+  if (!first_.empty()) return first_[size_t(ray)];
+  const int row = ray / size_;
+  uint32_t begin = row_first_[size_t(row)];
+  for (int r = row * size_; r < ray; ++r) begin += counts_[size_t(r)];
+  return begin;
+}
+
 std::span<const PackedPoint> RayFamily::points(int ray) const {
   if (is_uniform()) return {};
-  if (!first_.empty()) {
-    return std::span<const PackedPoint>(points_.data() + first_[ray], first_[ray + 1] - first_[ray]);
-  }
-  const int row = ray / size_;
-  uint32_t begin = row_first_[row];
-  for (int r = row * size_; r < ray; ++r) begin += counts_[r];
-  return std::span<const PackedPoint>(points_.data() + begin, counts_[ray]);
+  return std::span<const PackedPoint>(points_.data() + first_point(ray), point_count(ray));
 }
 
 size_t RayFamily::memory_bytes() const {

@@ -135,6 +135,15 @@ class RayFamily {
   bool uniform_inside() const { return uniform_inside_; }
   bool starts_inside(int ray) const;
   std::span<const PackedPoint> points(int ray) const;
+  // Index in all_points() of the ray's first point (sums the counts of the
+  // rays before it in its row). Walks along a row can instead add up
+  // point_count() themselves.
+  uint32_t first_point(int ray) const;
+  // Points on one ray, in constant time (no offset sums): lets walks skip empty rays.
+  uint32_t point_count(int ray) const {
+    if (is_uniform()) return 0;
+    return first_.empty() ? counts_[size_t(ray)] : first_[size_t(ray) + 1] - first_[size_t(ray)];
+  }
   size_t point_count() const { return points_.size(); }
   size_t memory_bytes() const;
 

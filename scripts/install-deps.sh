@@ -9,6 +9,8 @@ packages=(
   libtbb-dev libglm-dev libzstd-dev libstb-dev
   # CGAL: exact predicates, mesh repair and test references
   libcgal-dev libgmp-dev libmpfr-dev libboost-dev
+  # contour: mesh output and export
+  libopenmesh-dev libdraco-dev libtinygltf-dev libmeshoptimizer-dev
   # tool
   libcli11-dev nlohmann-json3-dev
   # tests, fuzzing, benchmarks

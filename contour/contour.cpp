@@ -1,0 +1,256 @@
+// Dual contouring of a World: per chunk in parallel, assembled into one mesh.
+#include "contour/contour.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <new>
+#include <set>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "contour/detail/region_mesher.h"
+#include "ldc/detail/ray_math.h"
+
+namespace ldc {
+
+const char* placement_name(Placement p) {
+  switch (p) {
+    case Placement::kIterative: return "iterative";
+    case Placement::kQef: return "qef";
+    case Placement::kMassPoint: return "masspoint";
+  }
+  return "?";
+}
+
+Status check_contour_config(const ContourConfig& c) {
+  auto bad = [](const std::string& field, double value, const char* rule) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "contour: " + field + " = " + std::to_string(value) + " must be " + rule);
+  };
+  if (c.iterations < 0 || c.iterations > 1000) return bad("iterations", c.iterations, "in 0 .. 1000");
+  if (!(c.step > 0.0 && c.step < 2.0)) return bad("step", c.step, "in (0, 2)");
+  if (!(c.qef_truncation >= 0.0 && c.qef_truncation < 1.0)) return bad("qef_truncation", c.qef_truncation, "in [0, 1)");
+  if (!(c.cell_slack >= 0.0 && c.cell_slack <= 1.0)) return bad("cell_slack", c.cell_slack, "in [0, 1]");
+  if (c.relax_iterations < 0 || c.relax_iterations > 16) return bad("relax_iterations", c.relax_iterations, "in 0 .. 16");
+  if (!(c.relax_strength >= 0.0 && c.relax_strength <= 1.0)) return bad("relax_strength", c.relax_strength, "in [0, 1]");
+  if (!(c.relax_plane_pull >= 0.0 && c.relax_plane_pull <= 1.0)) return bad("relax_plane_pull", c.relax_plane_pull, "in [0, 1]");
+  return {};
+}
+
+namespace {
+
+bool chunk_less(const glm::ivec3& a, const glm::ivec3& b) {
+  if (a.z != b.z) return a.z < b.z;
+  if (a.y != b.y) return a.y < b.y;
+  return a.x < b.x;
+}
+
+// Nothing to mesh when the chunk and all 26 around it are uniform and alike:
+// its region (the chunk plus a margin smaller than a chunk) holds no surface.
+bool chunk_is_quiet(const World& w, const glm::ivec3& ch) {
+  ChunkKind kind = w.chunk_kind(ch);
+  if (kind == ChunkKind::kMixed) return false;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (w.chunk_kind(ch + glm::ivec3(dx, dy, dz)) != kind) return false;
+  return true;
+}
+
+void add_stats(ContourStats& into, const ContourStats& s) {
+  into.chunks_meshed += s.chunks_meshed;
+  into.cells += s.cells;
+  into.quads += s.quads;
+  into.multi_crossing_edges += s.multi_crossing_edges;
+  into.thin_edges += s.thin_edges;
+  into.clamped_vertices += s.clamped_vertices;
+  into.relaxed_vertices += s.relaxed_vertices;
+  for (int i = 0; i < 4; ++i) into.qef_rank[i] += s.qef_rank[i];
+}
+
+// The chunks to mesh: the world's, and one layer below it on each axis, whose
+// cells straddle the box's lower faces.
+std::vector<glm::ivec3> chunks_to_mesh(const World& w) {
+  std::vector<glm::ivec3> out;
+  const glm::ivec3 lo = w.chunk_origin() - 1, hi = w.chunk_origin() + w.chunk_dims();
+  for (int z = lo.z; z < hi.z; ++z)
+    for (int y = lo.y; y < hi.y; ++y)
+      for (int x = lo.x; x < hi.x; ++x) out.emplace_back(x, y, z);
+  return out;
+}
+
+// Meshes `chunks` in parallel; empty results are dropped. Sorted by chunk.
+Result<std::vector<ChunkMesh>> mesh_chunks(const World& w, const std::vector<glm::ivec3>& chunks,
+                                           const ContourConfig& config, Context* ctx, ContourStats& stats) {
+  std::vector<ChunkMesh> meshes(chunks.size());
+  // One mesher per thread, so its buffers are allocated once per thread.
+  tbb::enumerable_thread_specific<detail::RegionMesher> meshers(detail::RegionMesher(w, config));
+  std::mutex mutex;
+  std::atomic<size_t> done{0};
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t i) {
+    if (ctx && ctx->cancelled()) return;
+    ContourStats local;
+    meshes[i].chunk = chunks[i];
+    if (!chunk_is_quiet(w, chunks[i])) {
+      const int c = w.chunk_size();
+      meshers.local().mesh(chunks[i] * c, chunks[i] * c + c, meshes[i], local);
+      local.chunks_meshed = 1;
+    }
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      add_stats(stats, local);
+    }
+    size_t n = done.fetch_add(1) + 1;
+    if (ctx && n % 16 == 0) ctx->report_progress("contour", double(n) / double(chunks.size()));
+  });
+  if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "contour: cancelled");
+  std::vector<ChunkMesh> kept;
+  for (ChunkMesh& m : meshes) {
+    if (!m.mesh.positions.empty()) kept.push_back(std::move(m));
+  }
+  return kept;
+}
+
+}  // namespace
+
+Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk, const ContourConfig& config,
+                                ContourStats* stats) {
+  Status s = check_contour_config(config);
+  if (!s.ok()) return s;
+  ContourStats local;
+  Result<std::vector<ChunkMesh>> r = mesh_chunks(world, {chunk}, config, nullptr, local);
+  if (stats) add_stats(*stats, local);
+  if (!r.ok()) return r.status();
+  if (r.value().empty()) {
+    ChunkMesh empty;
+    empty.chunk = chunk;
+    return empty;
+  }
+  return std::move(r.value().front());
+}
+
+Status ChunkedMesh::build(const World& world, Context* ctx) {
+  Status s = check_contour_config(config_);
+  if (!s.ok()) return s;
+  ScopedTimer timer(ctx, "contour");
+  ContourStats stats;
+  Result<std::vector<ChunkMesh>> r = mesh_chunks(world, chunks_to_mesh(world), config_, ctx, stats);
+  if (!r.ok()) return r.status();
+  chunks_ = std::move(r.value());
+  chunk_size_ = world.chunk_size();
+  stats.seconds = timer.seconds();
+  stats_ = stats;
+  return {};
+}
+
+Result<size_t> ChunkedMesh::update(const World& world, const std::vector<glm::ivec3>& changed, Context* ctx) {
+  if (world.chunk_size() != chunk_size_) {
+    return Status(ErrorCode::kInvalidArgument, "contour: update with a world of another chunk size");
+  }
+  // A chunk's mesh reads its region: the chunk and a margin into all 26 neighbours.
+  auto less = [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); };
+  std::set<glm::ivec3, decltype(less)> todo(less);
+  for (const glm::ivec3& c : changed)
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) todo.insert(c + glm::ivec3(dx, dy, dz));
+  std::vector<glm::ivec3> list(todo.begin(), todo.end());
+  ContourStats stats;
+  Result<std::vector<ChunkMesh>> r = mesh_chunks(world, list, config_, ctx, stats);
+  if (!r.ok()) return r.status();
+  std::vector<ChunkMesh> merged;
+  for (ChunkMesh& m : chunks_) {
+    if (!todo.count(m.chunk)) merged.push_back(std::move(m));
+  }
+  for (ChunkMesh& m : r.value()) merged.push_back(std::move(m));
+  std::sort(merged.begin(), merged.end(), [](const ChunkMesh& a, const ChunkMesh& b) { return chunk_less(a.chunk, b.chunk); });
+  chunks_ = std::move(merged);
+  add_stats(stats_, stats);
+  return list.size();
+}
+
+ContourMesh ChunkedMesh::assemble() const {
+  ContourMesh out;
+  std::vector<size_t> base(chunks_.size() + 1, 0);
+  for (size_t i = 0; i < chunks_.size(); ++i) base[i + 1] = base[i] + chunks_[i].own_vertices;
+  auto global_index = [&](const glm::ivec3& cell) -> uint32_t {
+    glm::ivec3 owner(detail::floor_div(cell.x, chunk_size_), detail::floor_div(cell.y, chunk_size_),
+                     detail::floor_div(cell.z, chunk_size_));
+    auto it = std::lower_bound(chunks_.begin(), chunks_.end(), owner,
+                               [](const ChunkMesh& m, const glm::ivec3& c) { return chunk_less(m.chunk, c); });
+    const ChunkMesh& m = *it;  // the owner always has this vertex: its cell has a sign change
+    auto begin = m.vertex_cell.begin(), end = begin + long(m.own_vertices);
+    auto v = std::lower_bound(begin, end, cell, [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); });
+    return uint32_t(base[size_t(it - chunks_.begin())] + size_t(v - begin));
+  };
+  for (const ChunkMesh& m : chunks_) {
+    for (size_t v = 0; v < m.own_vertices; ++v) {
+      out.positions.push_back(m.mesh.positions[v]);
+      out.normals.push_back(m.mesh.normals[v]);
+      out.vertex_material.push_back(m.mesh.vertex_material[v]);
+    }
+  }
+  for (size_t i = 0; i < chunks_.size(); ++i) {
+    const ChunkMesh& m = chunks_[i];
+    std::vector<uint32_t> map(m.mesh.positions.size());
+    for (size_t v = 0; v < map.size(); ++v) {
+      map[v] = v < m.own_vertices ? uint32_t(base[i] + v) : global_index(m.vertex_cell[v]);
+    }
+    for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+      const glm::uvec3& tri = m.mesh.triangles[t];
+      out.triangles.push_back({map[tri.x], map[tri.y], map[tri.z]});
+      out.triangle_material.push_back(m.mesh.triangle_material[t]);
+    }
+  }
+  return out;
+}
+
+namespace {
+
+// The whole world as one box: for tests of the chunked path.
+Result<ContourMesh> contour_one_piece(const World& world, const ContourConfig& config, ContourStats& stats) {
+  const glm::ivec3 lo = world.node_min() - 1, hi = world.node_end();
+  glm::ivec3 size = hi - lo;
+  if (size.x > 256 || size.y > 256 || size.z > 256) {
+    return Status(ErrorCode::kTooLarge, "contour: one-piece meshing is limited to 256^3 cells; use chunked");
+  }
+  detail::RegionMesher mesher(world, config);
+  ChunkMesh m;
+  mesher.mesh(lo, hi, m, stats);
+  stats.chunks_meshed = 1;
+  return std::move(m.mesh);
+}
+
+}  // namespace
+
+Result<ContourMesh> contour_world(const World& world, const ContourConfig& config, Context* ctx,
+                                  ContourStats* stats) {
+  Status s = check_contour_config(config);
+  if (!s.ok()) return s;
+  try {
+    ScopedTimer timer(ctx, "contour");
+    if (!config.chunked) {
+      ContourStats local;
+      Result<ContourMesh> m = contour_one_piece(world, config, local);
+      local.seconds = timer.seconds();
+      if (stats) *stats = local;
+      return m;
+    }
+    ChunkedMesh chunked(config);
+    s = chunked.build(world, ctx);
+    if (!s.ok()) return s;
+    ContourMesh mesh = chunked.assemble();
+    if (stats) {
+      *stats = chunked.stats();
+      stats->seconds = timer.seconds();
+    }
+    return mesh;
+  } catch (const std::bad_alloc&) {
+    return Status(ErrorCode::kTooLarge, "contour: out of memory");
+  }
+}
+
+}  // namespace ldc

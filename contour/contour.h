@@ -1,0 +1,180 @@
+// Dual contouring on LDC rays: the surface a player sees.
+//
+// Every edge of a lattice cell is a segment of an LDC ray, so the surface
+// crossings on a cell's 12 edges, with their exact normals, are read straight
+// out of the span lists. One vertex per cell whose corners differ, placed by
+// the Hermite planes of its crossings; one quad per edge whose ends differ,
+// joining the four cells around it, split into two triangles and oriented
+// with its normal pointing out of the solid.
+//
+// Rules this module follows (documented choices):
+// - An edge with several crossings (an odd number when its ends differ)
+//   contributes the crossing nearest to its outside end: the surface seen from
+//   outside. Counted in ContourStats::multi_crossing_edges.
+// - An edge whose ends agree but which holds crossings (a feature thinner than
+//   the cell) contributes nothing. Counted in ContourStats::thin_edges.
+// - A quad is split along the diagonal whose midpoint fits the Hermite planes
+//   of the diagonal's two end cells best (least summed squared distance); a
+//   diagonal lying on a crease fits exactly. Ties go to the shorter diagonal.
+// - A quad takes the material of its edge's crossing. A vertex takes the most
+//   common material among its cell's crossings (ties: the smaller id).
+// - A vertex's normal is the mean of its cell's crossing normals (the exact
+//   surface normals the LDC stores), so it needs no neighbours and agrees
+//   across chunk borders.
+//
+// Chunked meshing: each chunk meshes the cells it owns and the quads of the
+// edges it owns, reading its neighbours' rays for the cells and edges across
+// its border. The assembled mesh equals meshing the world in one piece.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "ldc/context.h"
+#include "ldc/status.h"
+#include "ldc/world.h"
+
+namespace ldc {
+
+// Where a cell's vertex goes, given the Hermite planes of its crossings.
+enum class Placement {
+  // Schmitz, Dietrich & Comba 2009: start at the mass point and move the
+  // vertex `iterations` times by `step` times the mean pull of the planes,
+  // sum_i n_i (n_i . (p_i - x)) / N. Simple, GPU-friendly; sharp edges can
+  // come out slightly wobbly when the iterations are few.
+  kIterative,
+  // Ju et al. 2002: minimise the quadratic error sum_i (n_i . (x - p_i))^2
+  // with a pseudo-inverse about the mass point, dropping eigenvalues below
+  // qef_truncation times the largest (the rank is recorded).
+  kQef,
+  // The mean of the crossings (no use of normals): the baseline.
+  kMassPoint,
+};
+const char* placement_name(Placement p);
+
+struct ContourConfig {
+  Placement placement = Placement::kIterative;
+  // kIterative: moves per vertex [Limit: 0 .. 1000] and step [Limit: (0, 2)].
+  int iterations = 16;
+  double step = 1.0;
+  // kQef: relative eigenvalue cut-off [Limit: [0, 1)].
+  double qef_truncation = 0.1;
+  // How far a vertex may leave its cell, as a fraction of h [Limit: 0 .. 1].
+  // Where a feature's planes meet outside the cell, the vertex goes to the
+  // best point inside the cell grown by this slack (for kQef and kIterative),
+  // which is off the surface: with 0, vertices next to features that cross a
+  // cell border sit up to about a third of a cell off; with 1, rotated boxes
+  // come out with every vertex within 0.001 h of a face and every corner kept
+  // (tests/test_contour.cpp measures both). More slack lets neighbouring
+  // triangles fold over more easily.
+  double cell_slack = 0.0;
+  // Material-border relaxation: vertices whose quads have different
+  // materials move `relax_iterations` times by `relax_strength` towards the
+  // mean of their neighbours on the border (an elastic net), then back onto
+  // their planes (8 particle steps of size `relax_plane_pull`), so they slide
+  // along the surface, staying in their cell.
+  int relax_iterations = 4;        // [Limit: 0 .. 16]; 0 turns it off
+  double relax_strength = 0.5;     // [Limit: [0, 1]]
+  double relax_plane_pull = 1.0;   // [Limit: [0, 1]]
+  // Mesh the world chunk by chunk in parallel (the default), or in one
+  // piece (for tests; refuses worlds larger than 256 cells along an axis).
+  bool chunked = true;
+};
+
+Status check_contour_config(const ContourConfig& config);
+
+// A triangle mesh in world coordinates.
+struct ContourMesh {
+  std::vector<glm::dvec3> positions;
+  std::vector<glm::vec3> normals;             // one per vertex, unit
+  std::vector<uint16_t> vertex_material;      // one per vertex
+  std::vector<glm::uvec3> triangles;          // counter-clockwise seen from outside
+  std::vector<uint16_t> triangle_material;    // one per triangle
+
+  size_t vertex_count() const { return positions.size(); }
+  size_t triangle_count() const { return triangles.size(); }
+};
+
+struct ContourStats {
+  double seconds = 0.0;
+  size_t chunks_meshed = 0;
+  size_t cells = 0;                  // cells that got a vertex
+  size_t quads = 0;
+  size_t multi_crossing_edges = 0;   // sign-changing edges with 3 or more crossings
+  size_t thin_edges = 0;             // edges with crossings but equal ends (ignored)
+  size_t clamped_vertices = 0;       // vertices the cell (plus slack) held back from their planes' optimum
+  size_t relaxed_vertices = 0;       // vertices on a material border
+  size_t qef_rank[4] = {0, 0, 0, 0};  // kQef: how many cells solved with rank 0..3
+};
+
+// Meshes the whole world.
+Result<ContourMesh> contour_world(const World& world, const ContourConfig& config = {},
+                                  Context* ctx = nullptr, ContourStats* stats = nullptr);
+
+// The mesh of one chunk: its own vertices first, then copies of the
+// neighbours' vertices its quads use, so it renders on its own without cracks.
+struct ChunkMesh {
+  glm::ivec3 chunk{0};
+  ContourMesh mesh;
+  size_t own_vertices = 0;          // mesh.positions[0 .. own_vertices) belong to this chunk
+  std::vector<glm::ivec3> vertex_cell;  // the lattice cell of every vertex
+};
+
+// Meshes one chunk. Chunks that are empty or solid, and whose neighbours
+// along the low side are too, produce an empty mesh without reading a ray.
+Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk,
+                                const ContourConfig& config = {}, ContourStats* stats = nullptr);
+
+// Keeps one mesh per chunk and re-meshes only the chunks it is told changed.
+class ChunkedMesh {
+ public:
+  explicit ChunkedMesh(ContourConfig config = {}) : config_(config) {}
+  // Meshes every chunk of the world (in parallel).
+  Status build(const World& world, Context* ctx = nullptr);
+  // Re-meshes the given chunks and those whose meshes read them (the 26
+  // chunks around each: a chunk's mesh reads a margin of cells into all its
+  // neighbours); leaves every other chunk mesh as it was. Returns how many
+  // chunks were re-meshed.
+  Result<size_t> update(const World& world, const std::vector<glm::ivec3>& changed_chunks,
+                        Context* ctx = nullptr);
+  const std::vector<ChunkMesh>& chunks() const { return chunks_; }
+  // One welded mesh: every vertex once, chunk by chunk, in a fixed order.
+  ContourMesh assemble() const;
+  const ContourStats& stats() const { return stats_; }
+
+ private:
+  ContourConfig config_;
+  int chunk_size_ = 32;
+  std::vector<ChunkMesh> chunks_;  // non-empty chunk meshes, sorted by chunk (z, y, x)
+  ContourStats stats_;
+};
+
+// Marching cubes on the same data (vertices at the edge crossings, faces
+// resolved consistently): the baseline for tests and benchmarks.
+Result<ContourMesh> marching_cubes(const World& world, Context* ctx = nullptr);
+
+// --- Mesh quality -------------------------------------------------------------
+
+struct MeshQuality {
+  size_t triangles = 0;
+  size_t vertices = 0;
+  size_t boundary_edges = 0;        // edges used by one triangle
+  size_t nonmanifold_edges = 0;     // edges used by more than two triangles
+  size_t unpaired_edges = 0;        // edges not used once in each direction
+  size_t nonmanifold_vertices = 0;  // vertices whose triangle fan is not one disc
+  size_t degenerate_triangles = 0;  // zero area
+  size_t unused_vertices = 0;
+  // Minimum angle of each triangle, in bins of 10 degrees: [0,10), [10,20) .. [50,60].
+  size_t min_angle_histogram[6] = {0, 0, 0, 0, 0, 0};
+  double min_angle_deg = 0.0;
+  double area = 0.0;
+  double volume = 0.0;              // signed, from the triangles
+  bool closed() const { return boundary_edges == 0 && unpaired_edges == 0; }
+};
+
+MeshQuality mesh_quality(const ContourMesh& mesh);
+
+}  // namespace ldc

@@ -1,0 +1,57 @@
+// Vertex placement from the Hermite planes of a cell.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+#include "contour/contour.h"
+
+namespace ldc::detail {
+
+// The crossings on a cell's edges: at most 12 planes (a point and a normal).
+struct CellPlanes {
+  int count = 0;
+  glm::dvec3 point[12];
+  glm::dvec3 normal[12];
+  uint16_t material[12];
+
+  void add(const glm::dvec3& p, const glm::dvec3& n, uint16_t m) {
+    point[count] = p;
+    normal[count] = n;
+    material[count] = m;
+    ++count;
+  }
+  glm::dvec3 mass_point() const;
+  glm::vec3 mean_normal() const;  // unit; +z when the normals cancel
+  uint16_t majority_material() const;
+  bool mixed_materials() const;
+};
+
+// Sum of squared plane distances, sum_i (n_i . (x - p_i))^2, stored as
+// x^T A x - 2 b^T x + c.
+struct Qef {
+  double a00 = 0, a01 = 0, a02 = 0, a11 = 0, a12 = 0, a22 = 0;
+  glm::dvec3 b{0.0};
+  double c = 0;
+
+  static Qef of(const CellPlanes& planes);
+  double error(const glm::dvec3& x) const;
+  glm::dvec3 times(const glm::dvec3& x) const;  // A x
+};
+
+struct PlacedVertex {
+  glm::dvec3 position{0.0};  // same coordinates as the planes
+  int rank = 3;              // kQef: eigenvalues kept
+  bool clamped = false;      // the cell bound moved it
+};
+
+// Places the vertex of the cell [cell_min, cell_min + 1]^3.
+// `qef` is Qef::of(planes), computed once by the caller.
+PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::dvec3& cell_min,
+                          const ContourConfig& config);
+
+// Clamps x into the cell grown by `slack` on every side.
+glm::dvec3 clamp_to_cell(const glm::dvec3& x, const glm::dvec3& cell_min, double slack, bool* clamped);
+
+}  // namespace ldc::detail

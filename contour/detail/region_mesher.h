@@ -1,0 +1,67 @@
+// Meshes the cells and edges of one box of the lattice (a chunk, or the whole
+// world), reading a margin of neighbouring cells so that vertices, normals
+// and relaxation near the box border come out exactly as in any other box.
+#pragma once
+
+#include <vector>
+
+#include "contour/contour.h"
+#include "contour/detail/placement.h"
+#include "contour/detail/region.h"
+
+namespace ldc::detail {
+
+class RegionMesher {
+ public:
+  RegionMesher(const World& world, const ContourConfig& config) : world_(world), config_(config) {}
+
+  // Cells [own_lo, own_hi) (by their lowest corner) and the edges whose lower
+  // node lies there. Vertices of cells outside the box that these quads use
+  // are appended after the box's own vertices.
+  void mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats);
+
+  // Cells of margin needed around a box: quads read the cells one below, and
+  // relaxation reaches one cell further per iteration.
+  int margin() const { return config_.relax_iterations + 1; }
+
+ private:
+  struct CellVertex {
+    glm::ivec3 cell{0};
+    glm::dvec3 x{0.0};  // lattice coordinates relative to the cell's lowest node
+    Qef qef;
+    glm::vec3 normal{0.0f};  // mean of its crossings' normals
+    uint16_t material = 0;
+    bool border = false;  // its quads have different materials
+  };
+  struct Quad {
+    glm::ivec3 cell[4];  // counter-clockwise seen from outside
+    uint16_t material = 0;
+  };
+
+  void load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int margin);
+  bool single_material() const;
+  std::vector<uint8_t> cells_with_vertex() const;
+  CellPlanes planes_of(const glm::ivec3& cell) const;
+  void place_vertices(ContourStats& stats);
+  void relax();
+  glm::dvec3 relaxed_position(const glm::ivec3& cell) const;
+  bool edge_quad(int axis, const glm::ivec3& node, Quad* quad) const;
+  int cell_quads(const glm::ivec3& cell, Quad* quads) const;
+  // Triangle corners (indices into quad.cell) after the diagonal rule.
+  void split(const Quad& q, int tri[2][3]) const;
+  const CellVertex* vertex(const glm::ivec3& cell) const;
+  size_t cell_index(const glm::ivec3& cell) const;
+  bool in_cell_box(const glm::ivec3& cell) const;
+  void emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats);
+  void finish_vertices(ChunkMesh& out, ContourStats& stats) const;
+
+  const World& world_;
+  ContourConfig config_;
+  Region region_;
+  glm::ivec3 cell_lo_{0}, cell_hi_{0};
+  std::vector<int32_t> cell_vertex_;  // index into verts_, -1 without a vertex
+  std::vector<CellVertex> verts_;
+  std::vector<glm::ivec3> border_;  // cells whose vertex is on a material border
+};
+
+}  // namespace ldc::detail

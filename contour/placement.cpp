@@ -1,0 +1,181 @@
+// Mass point, QEF with a truncated pseudo-inverse (Ju et al. 2002), and the
+// iterative particle method (Schmitz, Dietrich & Comba 2009).
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "contour/detail/placement.h"
+
+namespace ldc::detail {
+
+glm::dvec3 CellPlanes::mass_point() const {
+  glm::dvec3 sum(0.0);
+  for (int i = 0; i < count; ++i) sum += point[i];
+  return count ? sum / double(count) : sum;
+}
+
+glm::vec3 CellPlanes::mean_normal() const {
+  glm::dvec3 sum(0.0);
+  for (int i = 0; i < count; ++i) sum += normal[i];
+  double len = glm::length(sum);
+  return len > 1e-12 ? glm::vec3(sum / len) : glm::vec3(0.0f, 0.0f, 1.0f);
+}
+
+uint16_t CellPlanes::majority_material() const {
+  if (!mixed_materials()) return count ? material[0] : 0;
+  uint16_t best = count ? material[0] : 0;
+  int best_n = 0;
+  for (int i = 0; i < count; ++i) {
+    int n = 0;
+    for (int j = 0; j < count; ++j) n += material[j] == material[i];
+    if (n > best_n || (n == best_n && material[i] < best)) {
+      best = material[i];
+      best_n = n;
+    }
+  }
+  return best;
+}
+
+bool CellPlanes::mixed_materials() const {
+  for (int i = 1; i < count; ++i)
+    if (material[i] != material[0]) return true;
+  return false;
+}
+
+Qef Qef::of(const CellPlanes& planes) {
+  Qef q;
+  for (int i = 0; i < planes.count; ++i) {
+    const glm::dvec3& n = planes.normal[i];
+    double d = glm::dot(n, planes.point[i]);
+    q.a00 += n.x * n.x;
+    q.a01 += n.x * n.y;
+    q.a02 += n.x * n.z;
+    q.a11 += n.y * n.y;
+    q.a12 += n.y * n.z;
+    q.a22 += n.z * n.z;
+    q.b += n * d;
+    q.c += d * d;
+  }
+  return q;
+}
+
+glm::dvec3 Qef::times(const glm::dvec3& x) const {
+  return {a00 * x.x + a01 * x.y + a02 * x.z, a01 * x.x + a11 * x.y + a12 * x.z,
+          a02 * x.x + a12 * x.y + a22 * x.z};
+}
+
+double Qef::error(const glm::dvec3& x) const {
+  return std::max(0.0, glm::dot(x, times(x)) - 2.0 * glm::dot(b, x) + c);
+}
+
+glm::dvec3 clamp_to_cell(const glm::dvec3& x, const glm::dvec3& cell_min, double slack, bool* clamped) {
+  glm::dvec3 lo = cell_min - slack, hi = cell_min + 1.0 + slack;
+  glm::dvec3 y = glm::clamp(x, lo, hi);
+  if (clamped) *clamped = y != x;
+  return y;
+}
+
+namespace {
+
+// Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations:
+// m = V diag(w) V^T, the columns of v are the eigenvectors.
+void symmetric_eigen(double m[3][3], double w[3], double v[3][3]) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) v[i][j] = i == j;
+  for (int sweep = 0; sweep < 12; ++sweep) {
+    double off = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
+    if (off < 1e-30) break;
+    for (int p = 0; p < 2; ++p) {
+      for (int q = p + 1; q < 3; ++q) {
+        if (std::abs(m[p][q]) < 1e-300) continue;
+        double theta = (m[q][q] - m[p][p]) / (2.0 * m[p][q]);
+        double t = (theta >= 0 ? 1.0 : -1.0) / (std::abs(theta) + std::sqrt(theta * theta + 1.0));
+        double c = 1.0 / std::sqrt(t * t + 1.0), s = t * c;
+        for (int k = 0; k < 3; ++k) {  // m = J^T m J
+          double mkp = m[k][p], mkq = m[k][q];
+          m[k][p] = c * mkp - s * mkq;
+          m[k][q] = s * mkp + c * mkq;
+        }
+        for (int k = 0; k < 3; ++k) {
+          double mpk = m[p][k], mqk = m[q][k];
+          m[p][k] = c * mpk - s * mqk;
+          m[q][k] = s * mpk + c * mqk;
+        }
+        for (int k = 0; k < 3; ++k) {
+          double vkp = v[k][p], vkq = v[k][q];
+          v[k][p] = c * vkp - s * vkq;
+          v[k][q] = s * vkp + c * vkq;
+        }
+      }
+    }
+  }
+  for (int i = 0; i < 3; ++i) w[i] = m[i][i];
+}
+
+// Minimiser of the QEF nearest the mass point: x = c + A^+ (b - A c), with
+// eigenvalues below truncation * largest dropped.
+glm::dvec3 solve_qef(const Qef& q, const glm::dvec3& mass, double truncation, int* rank) {
+  double m[3][3] = {{q.a00, q.a01, q.a02}, {q.a01, q.a11, q.a12}, {q.a02, q.a12, q.a22}};
+  double w[3], v[3][3];
+  symmetric_eigen(m, w, v);
+  double largest = std::max({std::abs(w[0]), std::abs(w[1]), std::abs(w[2])});
+  glm::dvec3 r = q.b - q.times(mass);
+  glm::dvec3 x = mass;
+  *rank = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (!(std::abs(w[i]) > truncation * largest) || largest == 0.0) continue;
+    glm::dvec3 e(v[0][i], v[1][i], v[2][i]);
+    x += e * (glm::dot(e, r) / w[i]);
+    ++*rank;
+  }
+  return x;
+}
+
+// The particle method: each step moves the vertex by `step` times the mean
+// pull sum_i n_i (n_i . (p_i - x)) / N of the planes. That pull is b - A x
+// with the QEF's A and b, so a step costs one 3x3 product, not a pass over
+// the planes. Each step is clamped to the box [lo, hi]: projected gradient
+// descent, which settles on the best point inside the box when the planes
+// meet outside it. *constrained reports whether the box ever stopped it.
+glm::dvec3 iterate_particle(const Qef& q, int planes, glm::dvec3 x, int iterations, double step,
+                            const glm::dvec3& lo, const glm::dvec3& hi, bool* constrained) {
+  const double s = step / planes;
+  for (int it = 0; it < iterations; ++it) {
+    glm::dvec3 free = x + (q.b - q.times(x)) * s;
+    x = glm::clamp(free, lo, hi);
+    *constrained = *constrained || x != free;
+  }
+  return x;
+}
+
+}  // namespace
+
+PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::dvec3& cell_min,
+                          const ContourConfig& config) {
+  PlacedVertex out;
+  const glm::dvec3 lo = cell_min - config.cell_slack, hi = cell_min + 1.0 + config.cell_slack;
+  glm::dvec3 mass = planes.mass_point();
+  switch (config.placement) {
+    case Placement::kMassPoint:
+      out.position = mass;  // inside the cell: a mean of points on its edges
+      break;
+    case Placement::kIterative:
+      out.position = iterate_particle(qef, planes.count, mass, config.iterations, config.step, lo, hi,
+                                      &out.clamped);
+      break;
+    case Placement::kQef: {
+      glm::dvec3 x = solve_qef(qef, mass, config.qef_truncation, &out.rank);
+      out.position = x;
+      if (glm::any(glm::lessThan(x, lo)) || glm::any(glm::greaterThan(x, hi))) {
+        // The planes meet outside the cell: settle on the best point inside it.
+        out.clamped = true;
+        bool unused = false;
+        out.position = iterate_particle(qef, planes.count, glm::clamp(x, lo, hi), 32, 1.0, lo, hi, &unused);
+      }
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace ldc::detail

@@ -1,0 +1,287 @@
+#include "contour/detail/region_mesher.h"
+
+#include <algorithm>
+
+namespace ldc::detail {
+namespace {
+
+glm::ivec3 unit(int axis) {
+  glm::ivec3 e(0);
+  e[axis] = 1;
+  return e;
+}
+
+}  // namespace
+
+bool RegionMesher::in_cell_box(const glm::ivec3& cell) const {
+  return glm::all(glm::greaterThanEqual(cell, cell_lo_)) && glm::all(glm::lessThan(cell, cell_hi_));
+}
+
+size_t RegionMesher::cell_index(const glm::ivec3& cell) const {
+  glm::ivec3 r = cell - cell_lo_, s = cell_hi_ - cell_lo_;
+  return (size_t(r.z) * s.y + size_t(r.y)) * s.x + size_t(r.x);
+}
+
+const RegionMesher::CellVertex* RegionMesher::vertex(const glm::ivec3& cell) const {
+  int32_t i = cell_vertex_[cell_index(cell)];  // callers stay inside the cell box
+  return i < 0 ? nullptr : &verts_[size_t(i)];
+}
+
+// The quad of the edge from `node` along `axis`, if its ends differ: the four
+// cells around the edge, counter-clockwise seen from the outside end.
+bool RegionMesher::edge_quad(int axis, const glm::ivec3& node, Quad* quad) const {
+  const EdgeCrossing* x = region_.crossing(axis, node);
+  if (!x) return false;
+  const glm::ivec3 eu = unit(axis_u(axis)), ev = unit(axis_v(axis));
+  // Counter-clockwise seen from +axis (u x v = axis); reversed when +axis is inside.
+  glm::ivec3 cells[4] = {node - eu - ev, node - ev, node, node - eu};
+  bool outward_plus = region_.inside(node);
+  for (int i = 0; i < 4; ++i) quad->cell[i] = outward_plus ? cells[i] : cells[3 - i];
+  quad->material = x->material;
+  return true;
+}
+
+// The quads around a cell's vertex: one per edge of the cell whose ends differ.
+int RegionMesher::cell_quads(const glm::ivec3& cell, Quad* quads) const {
+  int n = 0;
+  for (int a = 0; a < 3; ++a) {
+    const glm::ivec3 eu = unit(axis_u(a)), ev = unit(axis_v(a));
+    for (int k = 0; k < 4; ++k) {
+      glm::ivec3 node = cell + ((k & 1) ? eu : glm::ivec3(0)) + ((k & 2) ? ev : glm::ivec3(0));
+      if (edge_quad(a, node, &quads[n])) ++n;
+    }
+  }
+  return n;
+}
+
+// Positions are kept relative to each vertex's own cell, and a quad works in
+// the frame of its first cell, so every region computes the same bits.
+void RegionMesher::split(const Quad& q, int tri[2][3]) const {
+  const CellVertex* v[4];
+  glm::dvec3 p[4];
+  const glm::ivec3 frame = q.cell[0];
+  for (int i = 0; i < 4; ++i) {
+    v[i] = vertex(q.cell[i]);
+    p[i] = glm::dvec3(q.cell[i] - frame) + v[i]->x;
+  }
+  glm::dvec3 m02 = 0.5 * (p[0] + p[2]), m13 = 0.5 * (p[1] + p[3]);
+  auto err = [&](int i, const glm::dvec3& m) { return v[i]->qef.error(m - glm::dvec3(q.cell[i] - frame)); };
+  double e02 = err(0, m02) + err(2, m02);
+  double e13 = err(1, m13) + err(3, m13);
+  bool use02;
+  if (std::abs(e02 - e13) > 1e-9 * (1.0 + e02 + e13)) {
+    use02 = e02 < e13;
+  } else {
+    use02 = glm::length(p[0] - p[2]) <= glm::length(p[1] - p[3]);
+  }
+  static const int kDiag02[2][3] = {{0, 1, 2}, {0, 2, 3}};
+  static const int kDiag13[2][3] = {{0, 1, 3}, {1, 2, 3}};
+  const int(*t)[3] = use02 ? kDiag02 : kDiag13;
+  for (int i = 0; i < 2; ++i)
+    for (int j = 0; j < 3; ++j) tri[i][j] = t[i][j];
+}
+
+// The cells around every edge with a crossing get a vertex; the rest of the
+// region is never visited.
+std::vector<uint8_t> RegionMesher::cells_with_vertex() const {
+  std::vector<uint8_t> marked(size_t(cell_hi_.x - cell_lo_.x) * (cell_hi_.y - cell_lo_.y) * (cell_hi_.z - cell_lo_.z), 0);
+  for (const Region::EdgeRef& e : region_.crossing_edges()) {
+    const glm::ivec3 eu = unit(axis_u(e.axis)), ev = unit(axis_v(e.axis));
+    for (int k = 0; k < 4; ++k) {
+      glm::ivec3 cell = e.node - ((k & 1) ? eu : glm::ivec3(0)) - ((k & 2) ? ev : glm::ivec3(0));
+      if (glm::all(glm::greaterThanEqual(cell, cell_lo_)) && glm::all(glm::lessThan(cell, cell_hi_))) {
+        marked[cell_index(cell)] = 1;
+      }
+    }
+  }
+  return marked;
+}
+
+// The crossings on the cell's 12 edges, in a fixed order (axis, then the
+// edge's offset in u and v), with positions relative to the cell's lowest node.
+CellPlanes RegionMesher::planes_of(const glm::ivec3& cell) const {
+  const glm::dvec3 base(0.0);
+  CellPlanes planes;
+  for (int a = 0; a < 3; ++a) {
+    const EdgeCrossing* edges[4];
+    region_.cell_edges(a, cell, edges);
+    for (int k = 0; k < 4; ++k) {
+      if (!edges[k]) continue;
+      glm::dvec3 p = base;
+      p[axis_u(a)] += k & 1;
+      p[axis_v(a)] += (k >> 1) & 1;
+      p[a] += edges[k]->t;
+      planes.add(p, glm::dvec3(edges[k]->normal), edges[k]->material);
+    }
+  }
+  return planes;
+}
+
+void RegionMesher::place_vertices(ContourStats& stats) {
+  std::vector<uint8_t> marked = cells_with_vertex();
+  cell_vertex_.assign(marked.size(), -1);
+  verts_.clear();
+  border_.clear();
+  size_t i = 0;
+  for (int z = cell_lo_.z; z < cell_hi_.z; ++z) {
+    for (int y = cell_lo_.y; y < cell_hi_.y; ++y) {
+      for (int x = cell_lo_.x; x < cell_hi_.x; ++x, ++i) {
+        if (!marked[i]) continue;
+        glm::ivec3 cell(x, y, z);
+        CellPlanes planes = planes_of(cell);
+        CellVertex v;
+        v.cell = cell;
+        v.qef = Qef::of(planes);
+        PlacedVertex pv = place_vertex(planes, v.qef, glm::dvec3(0.0), config_);
+        v.x = pv.position;
+        v.material = planes.majority_material();
+        v.normal = planes.mean_normal();
+        v.border = planes.mixed_materials();
+        if (v.border) border_.push_back(cell);
+        cell_vertex_[i] = int32_t(verts_.size());
+        verts_.push_back(v);
+        if (config_.placement == Placement::kQef) ++stats.qef_rank[pv.rank];
+        stats.clamped_vertices += pv.clamped;
+      }
+    }
+  }
+}
+
+// Elastic net on material borders: every border vertex moves towards the mean
+// of its border neighbours (cells sharing a quad edge with it), then back
+// towards its planes, and stays in its cell. Jacobi steps, so the result does
+// not depend on the order cells are visited in.
+void RegionMesher::relax() {
+  if (config_.relax_iterations <= 0 || config_.relax_strength <= 0.0) return;
+  std::vector<glm::dvec3> next(border_.size());
+  for (int it = 0; it < config_.relax_iterations; ++it) {
+    for (size_t b = 0; b < border_.size(); ++b) next[b] = relaxed_position(border_[b]);
+    for (size_t b = 0; b < border_.size(); ++b) verts_[size_t(cell_vertex_[cell_index(border_[b])])].x = next[b];
+  }
+}
+
+// The elastic step, in the vertex's own cell frame: towards the mean of its
+// border neighbours, then back onto its planes (a few particle steps), and
+// into its cell.
+glm::dvec3 RegionMesher::relaxed_position(const glm::ivec3& cell) const {
+  const CellVertex& v = *vertex(cell);
+  Quad quads[12];
+  int n = cell_quads(cell, quads);
+  glm::dvec3 sum(0.0);
+  int count = 0;
+  for (int k = 0; k < n; ++k) {
+    int at = 0;
+    while (quads[k].cell[at] != cell) ++at;
+    for (int side : {1, 3}) {
+      const glm::ivec3& other = quads[k].cell[(at + side) % 4];
+      if (!in_cell_box(other)) continue;
+      const CellVertex* nb = vertex(other);
+      if (nb && nb->border) {
+        sum += glm::dvec3(other - cell) + nb->x;
+        ++count;
+      }
+    }
+  }
+  if (count == 0) return v.x;
+  glm::dvec3 p = v.x + config_.relax_strength * (sum / double(count) - v.x);
+  double planes = v.qef.a00 + v.qef.a11 + v.qef.a22;  // = number of planes
+  for (int it = 0; it < 8 && planes > 0.0; ++it) {
+    p += config_.relax_plane_pull * (v.qef.b - v.qef.times(p)) / planes;  // sum_i n_i (n_i . (p_i - x)) / N
+  }
+  return clamp_to_cell(p, glm::dvec3(0.0), config_.cell_slack, nullptr);
+}
+
+namespace {
+
+bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
+  return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
+}
+
+}  // namespace
+
+// Triangles of the quads of the box's own edges, in the order the region
+// found them (deterministic).
+void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out,
+                        ContourStats& stats) {
+  std::vector<int32_t> out_index(verts_.size(), -1);
+  ContourMesh& m = out.mesh;
+  auto add_vertex = [&](const glm::ivec3& cell) {
+    out_index[size_t(cell_vertex_[cell_index(cell)])] = int32_t(m.positions.size());
+    out.vertex_cell.push_back(cell);
+    m.positions.push_back(glm::dvec3(0.0));  // filled by finish_vertices
+  };
+  for (const CellVertex& v : verts_) {  // in cell order (z, y, x)
+    if (in_box(v.cell, own_lo, own_hi)) add_vertex(v.cell);
+  }
+  out.own_vertices = m.positions.size();
+  for (const Region::EdgeRef& e : region_.crossing_edges()) {
+    if (!in_box(e.node, own_lo, own_hi)) continue;
+    Quad q;
+    edge_quad(e.axis, e.node, &q);
+    int tri[2][3];
+    split(q, tri);
+    for (const auto& t : tri) {
+      uint32_t idx[3];
+      for (int j = 0; j < 3; ++j) {
+        int32_t vi = cell_vertex_[cell_index(q.cell[t[j]])];
+        if (out_index[size_t(vi)] < 0) add_vertex(q.cell[t[j]]);
+        idx[j] = uint32_t(out_index[size_t(vi)]);
+      }
+      m.triangles.push_back({idx[0], idx[1], idx[2]});
+      m.triangle_material.push_back(q.material);
+    }
+    ++stats.quads;
+  }
+  finish_vertices(out, stats);
+}
+
+void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
+  const Lattice& lat = world_.lattice();
+  ContourMesh& m = out.mesh;
+  m.normals.resize(m.positions.size());
+  m.vertex_material.resize(m.positions.size());
+  for (size_t i = 0; i < m.positions.size(); ++i) {
+    const CellVertex& v = *vertex(out.vertex_cell[i]);
+    m.positions[i] = lat.to_world(glm::dvec3(v.cell) + v.x);
+    m.normals[i] = v.normal;
+    m.vertex_material[i] = v.material;
+    if (i < out.own_vertices) stats.relaxed_vertices += v.border && config_.relax_iterations > 0;
+  }
+  stats.cells += out.own_vertices;
+}
+
+void RegionMesher::load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int margin) {
+  cell_lo_ = own_lo - margin;
+  cell_hi_ = own_hi + margin;
+  region_.load(world_, cell_lo_, cell_hi_ + 1, own_lo, own_hi);
+}
+
+// One material in the region: no vertex can sit on a material border.
+bool RegionMesher::single_material() const {
+  const auto& edges = region_.crossing_edges();
+  if (edges.empty()) return true;
+  uint16_t first = region_.crossing(edges[0].axis, edges[0].node)->material;
+  for (const Region::EdgeRef& e : edges) {
+    if (region_.crossing(e.axis, e.node)->material != first) return false;
+  }
+  return true;
+}
+
+void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out,
+                        ContourStats& stats) {
+  out.mesh = {};
+  out.vertex_cell.clear();
+  out.own_vertices = 0;
+  // Quads need the cells one below; relaxation one more cell per iteration,
+  // but only where materials meet.
+  load(own_lo, own_hi, 1);
+  if (config_.relax_iterations > 0 && !single_material()) load(own_lo, own_hi, margin());
+  stats.multi_crossing_edges += region_.multi_crossing_edges();
+  stats.thin_edges += region_.thin_edges();
+  if (region_.uniform()) return;
+  place_vertices(stats);
+  relax();
+  emit(own_lo, own_hi, out, stats);
+}
+
+}  // namespace ldc::detail
