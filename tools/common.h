@@ -63,5 +63,6 @@ void add_build_command(CLI::App& app, CommonOptions& common);
 void add_info_command(CLI::App& app, CommonOptions& common);
 void add_inside_command(CLI::App& app, CommonOptions& common);
 void add_terrain_command(CLI::App& app, CommonOptions& common);
+void add_contour_commands(CLI::App& app, CommonOptions& common);
 
 }  // namespace ldc::tool

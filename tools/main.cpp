@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   ldc::tool::add_info_command(app, common);
   ldc::tool::add_inside_command(app, common);
   ldc::tool::add_terrain_command(app, common);
+  ldc::tool::add_contour_commands(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
