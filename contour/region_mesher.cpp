@@ -1,6 +1,10 @@
 #include "contour/detail/region_mesher.h"
 
 #include <algorithm>
+#include <cstring>
+#include <unordered_map>
+
+#include <meshoptimizer.h>
 
 namespace ldc::detail {
 namespace {
@@ -12,6 +16,8 @@ glm::ivec3 unit(int axis) {
 }
 
 }  // namespace
+
+void optimize_triangle_order(ContourMesh& m);
 
 bool RegionMesher::in_cell_box(const glm::ivec3& cell) const {
   return glm::all(glm::greaterThanEqual(cell, cell_lo_)) && glm::all(glm::lessThan(cell, cell_hi_));
@@ -233,6 +239,27 @@ void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
     ++stats.quads;
   }
   finish_vertices(out, stats);
+  optimize_triangle_order(m);
+}
+
+// Reorders the chunk's triangles for the post-transform vertex cache
+// (meshoptimizer, Forsyth-like; about 0.68 vertices per triangle instead of
+// 1.2 to 1.5 in quad order), carrying each triangle's material along.
+void optimize_triangle_order(ContourMesh& m) {
+  if (m.triangles.size() < 2) return;
+  std::vector<uint32_t> in(m.triangles.size() * 3), out(in.size());
+  std::memcpy(in.data(), m.triangles.data(), in.size() * sizeof(uint32_t));
+  meshopt_optimizeVertexCache(out.data(), in.data(), in.size(), m.positions.size());
+  std::unordered_map<uint64_t, uint16_t> material;  // DC never repeats a triangle in one chunk
+  material.reserve(m.triangles.size());
+  auto key = [](uint32_t a, uint32_t b, uint32_t c) { return (uint64_t(a) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(b) << 21) ^ (uint64_t(c) << 42) ^ c; };
+  for (size_t t = 0; t < m.triangles.size(); ++t) {
+    material[key(m.triangles[t].x, m.triangles[t].y, m.triangles[t].z)] = m.triangle_material[t];
+  }
+  for (size_t t = 0; t < m.triangles.size(); ++t) {
+    m.triangles[t] = {out[3 * t], out[3 * t + 1], out[3 * t + 2]};
+    m.triangle_material[t] = material[key(out[3 * t], out[3 * t + 1], out[3 * t + 2])];
+  }
 }
 
 void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
