@@ -36,6 +36,9 @@ inline double median_ms(int reps, const std::function<void()>& fn) {
 // CPU, cores, compiler and date, as a markdown list.
 void print_machine();
 
+// The mesh with its holes closed by CGAL's triangulate_hole (bench/holefill.cpp).
+TriangleMesh fill_holes(const TriangleMesh& mesh, size_t* holes = nullptr);
+
 // Depth and normal error of every stored point against the exact mesh (CGAL
 // AABB tree), per mesh and resolution, as a markdown table.
 void print_accuracy(const Args& args, const std::vector<int>& resolutions);

@@ -4,7 +4,8 @@
 // ("meshdist(A = reference, B = test)"), so that the benchmarks' own figures
 // and the peer figures can sit in one table:
 //   - both surfaces are sampled area-weighted and uniformly, `samples` points
-//     each, from a fixed seed;
+//     each, from a fixed seed (stratified along the area CDF: the same
+//     distribution as independent draws, with less variance);
 //   - distances are point-to-surface (AABB tree, exact closest point);
 //   - `rel` figures are divided by the bounding-box diagonal of the reference;
 //   - the normal error of a test sample is the angle between its test face's

@@ -142,8 +142,33 @@ glm::dvec3 iterate_particle(const Qef& q, int planes, glm::dvec3 x, int iteratio
   const double s = step / planes;
   for (int it = 0; it < iterations; ++it) {
     glm::dvec3 free = x + (q.b - q.times(x)) * s;
-    x = glm::clamp(free, lo, hi);
-    *constrained = *constrained || x != free;
+    glm::dvec3 next = glm::clamp(free, lo, hi);
+    *constrained = *constrained || next != free;
+    // Settled: a step below 1e-6 cell changes nothing a mesh can show.
+    bool settled = glm::dot(next - x, next - x) < 1e-12;
+    x = next;
+    if (settled) break;
+  }
+  return x;
+}
+
+// The particle method's k unconstrained steps in closed form. The steps are
+// linear, x <- x + s/N (b - A x), so in A's eigenbasis each component of the
+// residual shrinks by (1 - s lambda / N) per step: after k steps x0 has moved
+// by sum_i g(lambda_i) e_i (e_i . r0), g(lambda) = (1 - (1 - s lambda/N)^k) / lambda.
+// One eigen-decomposition replaces k passes: many steps cost as little as few.
+glm::dvec3 particle_closed_form(const Qef& q, int planes, const glm::dvec3& x0, int iterations, double step) {
+  double m[3][3] = {{q.a00, q.a01, q.a02}, {q.a01, q.a11, q.a12}, {q.a02, q.a12, q.a22}};
+  double w[3], v[3][3];
+  symmetric_eigen(m, w, v);
+  const double s = step / planes;
+  const glm::dvec3 r = q.b - q.times(x0);
+  glm::dvec3 x = x0;
+  for (int i = 0; i < 3; ++i) {
+    double lambda = std::max(w[i], 0.0);
+    double g = lambda * s < 1e-12 ? iterations * s : (1.0 - std::pow(1.0 - s * lambda, iterations)) / lambda;
+    glm::dvec3 e(v[0][i], v[1][i], v[2][i]);
+    x += e * (g * glm::dot(e, r));
   }
   return x;
 }
@@ -159,10 +184,17 @@ PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::d
     case Placement::kMassPoint:
       out.position = mass;  // inside the cell: a mean of points on its edges
       break;
-    case Placement::kIterative:
-      out.position = iterate_particle(qef, planes.count, mass, config.iterations, config.step, lo, hi,
-                                      &out.clamped);
+    case Placement::kIterative: {
+      glm::dvec3 x = particle_closed_form(qef, planes.count, mass, config.iterations, config.step);
+      out.position = x;
+      if (glm::any(glm::lessThan(x, lo)) || glm::any(glm::greaterThan(x, hi))) {
+        // It leaves the cell: take steps one by one, each projected into the
+        // cell (at most 64: this point is off the planes anyway).
+        out.position = iterate_particle(qef, planes.count, mass, std::min(config.iterations, 64), config.step,
+                                        lo, hi, &out.clamped);
+      }
       break;
+    }
     case Placement::kQef: {
       glm::dvec3 x = solve_qef(qef, mass, config.qef_truncation, &out.rank);
       out.position = x;
