@@ -4,7 +4,8 @@ if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
   target_compile_options(ldc_build_flags INTERFACE
     $<$<COMPILE_LANGUAGE:CXX>:-Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor
       -Wcast-align -Woverloaded-virtual -Wimplicit-fallthrough
-      -Wno-missing-field-initializers>)  # designated initializers of config structs
+      -Wno-missing-field-initializers>  # designated initializers of config structs
+    -ffp-contract=off)  # no fused multiply-add: the same bits on every machine
 endif()
 if(LDC_SANITIZE)
   target_compile_options(ldc_build_flags INTERFACE

@@ -79,12 +79,13 @@ namespace {
 
 // Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations:
 // m = V diag(w) V^T, the columns of v are the eigenvectors.
-void symmetric_eigen(double m[3][3], double w[3], double v[3][3]) {
+void jacobi_eigen(double m[3][3], double w[3], double v[3][3]) {
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) v[i][j] = i == j;
-  for (int sweep = 0; sweep < 12; ++sweep) {
+  const double scale = m[0][0] * m[0][0] + m[1][1] * m[1][1] + m[2][2] * m[2][2] + 1e-300;
+  for (int sweep = 0; sweep < 8; ++sweep) {
     double off = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
-    if (off < 1e-30) break;
+    if (off < 1e-24 * scale) break;  // converges quadratically: 3 to 5 sweeps
     for (int p = 0; p < 2; ++p) {
       for (int q = p + 1; q < 3; ++q) {
         if (std::abs(m[p][q]) < 1e-300) continue;
@@ -110,6 +111,70 @@ void symmetric_eigen(double m[3][3], double w[3], double v[3][3]) {
     }
   }
   for (int i = 0; i < 3; ++i) w[i] = m[i][i];
+}
+
+// Eigen-decomposition of a symmetric 3x3 matrix: eigenvalues in closed form
+// (the trigonometric solution of the characteristic cubic), eigenvectors from
+// cross products of rows of A - lambda I (Kopp 2008, "Efficient numerical
+// diagonalization of hermitian 3x3 matrices"). Where two eigenvalues are too
+// close for cross products, the cyclic Jacobi method takes over.
+void symmetric_eigen(double m[3][3], double w[3], double v[3][3]) {
+  const double p1 = m[0][1] * m[0][1] + m[0][2] * m[0][2] + m[1][2] * m[1][2];
+  const double q = (m[0][0] + m[1][1] + m[2][2]) / 3.0;
+  const double d0 = m[0][0] - q, d1 = m[1][1] - q, d2 = m[2][2] - q;
+  const double p2 = d0 * d0 + d1 * d1 + d2 * d2 + 2.0 * p1;
+  const double scale = std::abs(q) + std::sqrt(p2) + 1e-300;
+  if (p2 < 1e-18 * scale * scale) {  // a multiple of the identity: any basis
+    for (int i = 0; i < 3; ++i) {
+      w[i] = m[i][i];
+      for (int j = 0; j < 3; ++j) v[i][j] = i == j;
+    }
+    return;
+  }
+  const double p = std::sqrt(p2 / 6.0);
+  double b[3][3];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) b[i][j] = (m[i][j] - (i == j ? q : 0.0)) / p;
+  double r = (b[0][0] * (b[1][1] * b[2][2] - b[1][2] * b[2][1]) - b[0][1] * (b[1][0] * b[2][2] - b[1][2] * b[2][0]) +
+              b[0][2] * (b[1][0] * b[2][1] - b[1][1] * b[2][0])) / 2.0;
+  double phi = std::acos(std::clamp(r, -1.0, 1.0)) / 3.0;
+  w[0] = q + 2.0 * p * std::cos(phi);
+  w[2] = q + 2.0 * p * std::cos(phi + 2.0943951023931953);  // + 2 pi / 3
+  w[1] = 3.0 * q - w[0] - w[2];
+  // An eigenvector of a distinct eigenvalue is the longest cross product of
+  // two rows of A - lambda I. Two close eigenvalues (a flat or gently curved
+  // cell: two near-zero ones) share an eigenspace, where any orthonormal
+  // pair will do.
+  const double gap = 1e-5 * scale;
+  const bool top_apart = w[0] - w[1] >= gap, bottom_apart = w[1] - w[2] >= gap;
+  auto vector_of = [&](double lambda) {
+    glm::dvec3 r0(m[0][0] - lambda, m[0][1], m[0][2]), r1(m[1][0], m[1][1] - lambda, m[1][2]),
+        r2(m[2][0], m[2][1], m[2][2] - lambda);
+    glm::dvec3 c[3] = {glm::cross(r0, r1), glm::cross(r0, r2), glm::cross(r1, r2)};
+    int best = 0;
+    for (int i = 1; i < 3; ++i)
+      if (glm::dot(c[i], c[i]) > glm::dot(c[best], c[best])) best = i;
+    return glm::normalize(c[best]);
+  };
+  auto any_perpendicular = [](const glm::dvec3& a) {
+    glm::dvec3 t = std::abs(a.x) < 0.6 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    return glm::normalize(glm::cross(a, t));
+  };
+  glm::dvec3 e[3];
+  if (top_apart) {
+    e[0] = vector_of(w[0]);
+    e[2] = bottom_apart ? vector_of(w[2]) : any_perpendicular(e[0]);
+    e[1] = glm::normalize(glm::cross(e[2], e[0]));
+  } else if (bottom_apart) {
+    e[2] = vector_of(w[2]);
+    e[0] = any_perpendicular(e[2]);
+    e[1] = glm::normalize(glm::cross(e[2], e[0]));
+  } else {
+    jacobi_eigen(m, w, v);  // all three close but not equal: rare
+    return;
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) v[i][k] = e[k][i];
 }
 
 // Minimiser of the QEF nearest the mass point: x = c + A^+ (b - A c), with
@@ -152,6 +217,14 @@ glm::dvec3 iterate_particle(const Qef& q, int planes, glm::dvec3 x, int iteratio
   return x;
 }
 
+// base^k by squaring (k >= 0).
+double power(double base, int k) {
+  double result = 1.0;
+  for (; k > 0; k >>= 1, base *= base)
+    if (k & 1) result *= base;
+  return result;
+}
+
 // The particle method's k unconstrained steps in closed form. The steps are
 // linear, x <- x + s/N (b - A x), so in A's eigenbasis each component of the
 // residual shrinks by (1 - s lambda / N) per step: after k steps x0 has moved
@@ -166,7 +239,7 @@ glm::dvec3 particle_closed_form(const Qef& q, int planes, const glm::dvec3& x0, 
   glm::dvec3 x = x0;
   for (int i = 0; i < 3; ++i) {
     double lambda = std::max(w[i], 0.0);
-    double g = lambda * s < 1e-12 ? iterations * s : (1.0 - std::pow(1.0 - s * lambda, iterations)) / lambda;
+    double g = lambda * s < 1e-12 ? iterations * s : (1.0 - power(1.0 - s * lambda, iterations)) / lambda;
     glm::dvec3 e(v[0][i], v[1][i], v[2][i]);
     x += e * (g * glm::dot(e, r));
   }

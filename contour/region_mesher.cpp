@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cstring>
-#include <unordered_map>
 
 #include <meshoptimizer.h>
 
@@ -243,23 +242,31 @@ void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
 }
 
 // Reorders the chunk's triangles for the post-transform vertex cache
-// (meshoptimizer, Forsyth-like; about 0.68 vertices per triangle instead of
-// 1.2 to 1.5 in quad order), carrying each triangle's material along.
+// (meshoptimizer's FIFO variant, several times faster than its Forsyth-like
+// one; about 0.7 vertices per triangle instead of 1.2 to 1.5 in quad order), carrying each triangle's material along: the
+// output triangle is found among the few triangles of its first vertex.
 void optimize_triangle_order(ContourMesh& m) {
-  if (m.triangles.size() < 2) return;
-  std::vector<uint32_t> in(m.triangles.size() * 3), out(in.size());
+  const size_t n = m.triangles.size();
+  if (n < 2) return;
+  std::vector<uint32_t> in(n * 3), out(in.size());
   std::memcpy(in.data(), m.triangles.data(), in.size() * sizeof(uint32_t));
-  meshopt_optimizeVertexCache(out.data(), in.data(), in.size(), m.positions.size());
-  std::unordered_map<uint64_t, uint16_t> material;  // DC never repeats a triangle in one chunk
-  material.reserve(m.triangles.size());
-  auto key = [](uint32_t a, uint32_t b, uint32_t c) { return (uint64_t(a) * 0x9E3779B97F4A7C15ull) ^ (uint64_t(b) << 21) ^ (uint64_t(c) << 42) ^ c; };
-  for (size_t t = 0; t < m.triangles.size(); ++t) {
-    material[key(m.triangles[t].x, m.triangles[t].y, m.triangles[t].z)] = m.triangle_material[t];
+  meshopt_optimizeVertexCacheFifo(out.data(), in.data(), in.size(), m.positions.size(), 16);
+  std::vector<uint32_t> first(m.positions.size() + 1, 0), of_vertex(n);
+  for (const glm::uvec3& t : m.triangles) ++first[t.x + 1];
+  for (size_t v = 0; v + 1 < first.size(); ++v) first[v + 1] += first[v];
+  std::vector<uint32_t> fill(first.begin(), first.end() - 1);
+  for (uint32_t t = 0; t < n; ++t) of_vertex[fill[m.triangles[t].x]++] = t;
+  std::vector<glm::uvec3> triangles(n);
+  std::vector<uint16_t> material(n);
+  for (size_t t = 0; t < n; ++t) {
+    glm::uvec3 tri(out[3 * t], out[3 * t + 1], out[3 * t + 2]);
+    triangles[t] = tri;
+    for (uint32_t k = first[tri.x]; k < first[tri.x + 1]; ++k) {
+      if (m.triangles[of_vertex[k]] == tri) material[t] = m.triangle_material[of_vertex[k]];
+    }
   }
-  for (size_t t = 0; t < m.triangles.size(); ++t) {
-    m.triangles[t] = {out[3 * t], out[3 * t + 1], out[3 * t + 2]};
-    m.triangle_material[t] = material[key(out[3 * t], out[3 * t + 1], out[3 * t + 2])];
-  }
+  m.triangles = std::move(triangles);
+  m.triangle_material = std::move(material);
 }
 
 void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
@@ -277,9 +284,10 @@ void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
   stats.cells += out.own_vertices;
 }
 
-void RegionMesher::load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int margin) {
-  cell_lo_ = own_lo - margin;
-  cell_hi_ = own_hi + margin;
+// Cells [own_lo - low, own_hi + high), and the nodes their corners need.
+void RegionMesher::load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int low, int high) {
+  cell_lo_ = own_lo - low;
+  cell_hi_ = own_hi + high;
   region_.load(world_, cell_lo_, cell_hi_ + 1, own_lo, own_hi);
 }
 
@@ -299,10 +307,12 @@ void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
   out.mesh = {};
   out.vertex_cell.clear();
   out.own_vertices = 0;
-  // Quads need the cells one below; relaxation one more cell per iteration,
-  // but only where materials meet.
-  load(own_lo, own_hi, 1);
-  if (config_.relax_iterations > 0 && !single_material()) load(own_lo, own_hi, margin());
+  // Quads need the cells one below; relaxation one more cell per iteration on
+  // every side, but only where materials meet.
+  load(own_lo, own_hi, 1, 0);
+  if (config_.relax_iterations > 0 && !single_material()) {
+    load(own_lo, own_hi, margin(), margin() - 1);
+  }
   stats.multi_crossing_edges += region_.multi_crossing_edges();
   stats.thin_edges += region_.thin_edges();
   if (region_.uniform()) return;

@@ -20,8 +20,8 @@ class RegionMesher {
   // are appended after the box's own vertices.
   void mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats);
 
-  // Cells of margin needed around a box: quads read the cells one below, and
-  // relaxation reaches one cell further per iteration.
+  // Cells of margin needed below a box (quads read the cells one below) when
+  // relaxation runs: it reaches one cell further per iteration, on every side.
   int margin() const { return config_.relax_iterations + 1; }
 
  private:
@@ -38,7 +38,7 @@ class RegionMesher {
     uint16_t material = 0;
   };
 
-  void load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int margin);
+  void load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int low, int high);
   bool single_material() const;
   std::vector<uint8_t> cells_with_vertex() const;
   CellPlanes planes_of(const glm::ivec3& cell) const;
