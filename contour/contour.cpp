@@ -172,10 +172,15 @@ Result<size_t> ChunkedMesh::update(const World& world, const std::vector<glm::iv
   return list.size();
 }
 
+// Chunk by chunk in parallel: each chunk's own vertices and triangles go to
+// fixed offsets (prefix sums), so the result does not depend on the threads.
 ContourMesh ChunkedMesh::assemble() const {
-  ContourMesh out;
-  std::vector<size_t> base(chunks_.size() + 1, 0);
-  for (size_t i = 0; i < chunks_.size(); ++i) base[i + 1] = base[i] + chunks_[i].own_vertices;
+  const size_t n = chunks_.size();
+  std::vector<size_t> vbase(n + 1, 0), tbase(n + 1, 0);
+  for (size_t i = 0; i < n; ++i) {
+    vbase[i + 1] = vbase[i] + chunks_[i].own_vertices;
+    tbase[i + 1] = tbase[i] + chunks_[i].mesh.triangles.size();
+  }
   auto global_index = [&](const glm::ivec3& cell) -> uint32_t {
     glm::ivec3 owner(detail::floor_div(cell.x, chunk_size_), detail::floor_div(cell.y, chunk_size_),
                      detail::floor_div(cell.z, chunk_size_));
@@ -184,27 +189,30 @@ ContourMesh ChunkedMesh::assemble() const {
     const ChunkMesh& m = *it;  // the owner always has this vertex: its cell has a sign change
     auto begin = m.vertex_cell.begin(), end = begin + long(m.own_vertices);
     auto v = std::lower_bound(begin, end, cell, [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); });
-    return uint32_t(base[size_t(it - chunks_.begin())] + size_t(v - begin));
+    return uint32_t(vbase[size_t(it - chunks_.begin())] + size_t(v - begin));
   };
-  for (const ChunkMesh& m : chunks_) {
-    for (size_t v = 0; v < m.own_vertices; ++v) {
-      out.positions.push_back(m.mesh.positions[v]);
-      out.normals.push_back(m.mesh.normals[v]);
-      out.vertex_material.push_back(m.mesh.vertex_material[v]);
-    }
-  }
-  for (size_t i = 0; i < chunks_.size(); ++i) {
+  ContourMesh out;
+  out.positions.resize(vbase[n]);
+  out.normals.resize(vbase[n]);
+  out.vertex_material.resize(vbase[n]);
+  out.triangles.resize(tbase[n]);
+  out.triangle_material.resize(tbase[n]);
+  tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     const ChunkMesh& m = chunks_[i];
+    std::copy_n(m.mesh.positions.begin(), m.own_vertices, out.positions.begin() + long(vbase[i]));
+    std::copy_n(m.mesh.normals.begin(), m.own_vertices, out.normals.begin() + long(vbase[i]));
+    std::copy_n(m.mesh.vertex_material.begin(), m.own_vertices, out.vertex_material.begin() + long(vbase[i]));
     std::vector<uint32_t> map(m.mesh.positions.size());
     for (size_t v = 0; v < map.size(); ++v) {
-      map[v] = v < m.own_vertices ? uint32_t(base[i] + v) : global_index(m.vertex_cell[v]);
+      map[v] = v < m.own_vertices ? uint32_t(vbase[i] + v) : global_index(m.vertex_cell[v]);
     }
     for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
       const glm::uvec3& tri = m.mesh.triangles[t];
-      out.triangles.push_back({map[tri.x], map[tri.y], map[tri.z]});
-      out.triangle_material.push_back(m.mesh.triangle_material[t]);
+      out.triangles[tbase[i] + t] = {map[tri.x], map[tri.y], map[tri.z]};
     }
-  }
+    std::copy(m.mesh.triangle_material.begin(), m.mesh.triangle_material.end(),
+              out.triangle_material.begin() + long(tbase[i]));
+  });
   return out;
 }
 

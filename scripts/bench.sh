@@ -14,6 +14,13 @@ mkdir -p docs
   echo "## LDC build (issue 2)"
   echo
   ./build/bench/bench_build
+  echo
+  echo "## Dual contouring: remesh time against error (issue 3)"
+  echo
+  echo "Plots of time against error: contour_fandisk.svg, contour_rocker-arm.svg, contour_spot.svg,"
+  echo "contour_stanford-bunny-filled.svg (in docs/)."
+  echo
+  ./build/bench/bench_contour --plots docs
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"
