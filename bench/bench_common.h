@@ -39,6 +39,10 @@ void print_machine();
 // The mesh with its holes closed by CGAL's triangulate_hole (bench/holefill.cpp).
 TriangleMesh fill_holes(const TriangleMesh& mesh, size_t* holes = nullptr);
 
+// Pairs of triangles that intersect other than at a shared edge or vertex
+// (CGAL Polygon_mesh_processing::self_intersections).
+size_t self_intersections(const TriangleMesh& mesh);
+
 // Depth and normal error of every stored point against the exact mesh (CGAL
 // AABB tree), per mesh and resolution, as a markdown table.
 void print_accuracy(const Args& args, const std::vector<int>& resolutions);
