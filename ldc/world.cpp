@@ -239,6 +239,25 @@ std::shared_ptr<const Chunk> World::chunk_shared(const glm::ivec3& c) const {
   return contains_chunk(c) ? chunks_[chunk_slot(c)] : nullptr;
 }
 
+Status World::grow_to_include(const glm::ivec3& lo, const glm::ivec3& hi) {
+  WorldConfig grown = config_;
+  grown.chunk_origin = glm::min(config_.chunk_origin, lo);
+  grown.chunk_dims = glm::max(config_.chunk_origin + config_.chunk_dims, hi) - grown.chunk_origin;
+  if (grown.chunk_origin == config_.chunk_origin && grown.chunk_dims == config_.chunk_dims) return {};
+  Status s = check_world_config(grown);
+  if (!s.ok()) return s;
+  World bigger(grown);
+  for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk*) {
+    size_t to = bigger.chunk_slot(ch), from = chunk_slot(ch);
+    bigger.kinds_[to] = kind;
+    bigger.chunks_[to] = chunks_[from];
+  });
+  config_ = grown;
+  kinds_ = std::move(bigger.kinds_);
+  chunks_ = std::move(bigger.chunks_);
+  return {};
+}
+
 void World::set_chunk(const glm::ivec3& c, std::shared_ptr<const Chunk> data) {
   assert(contains_chunk(c));
   bool inside = false;

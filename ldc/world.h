@@ -251,6 +251,11 @@ class World {
   const Chunk* chunk(const glm::ivec3& chunk) const;
   std::shared_ptr<const Chunk> chunk_shared(const glm::ivec3& chunk) const;
 
+  // Grows the chunk box to include chunks [lo, hi) (exclusive); new chunks are
+  // empty, existing ones keep their data. Fails (and changes nothing) past
+  // the limits World::create enforces.
+  Status grow_to_include(const glm::ivec3& lo, const glm::ivec3& hi);
+
   // Stores a chunk, collapsing it to a flag when uniform. Requires contains_chunk.
   void set_chunk(const glm::ivec3& chunk, std::shared_ptr<const Chunk> data);
   void set_uniform_chunk(const glm::ivec3& chunk, bool solid);

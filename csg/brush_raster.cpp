@@ -1,0 +1,162 @@
+// Brush rasterizers. Primitives and noise spheres go through the implicit
+// builder (node signs sampled, exact or root-searched crossings), meshes
+// through the watertight mesh builder, all on the world's own lattice so the
+// result's chunks line up with the world's.
+#include <cmath>
+#include <cstdint>
+
+#include "csg/detail/brush_raster.h"
+
+namespace ldc::detail {
+namespace {
+
+uint32_t hash3(int x, int y, int z, uint32_t seed) {
+  uint32_t h = seed * 0x9E3779B1u;
+  h ^= uint32_t(x) * 0x85EBCA6Bu;
+  h = (h << 13) | (h >> 19);
+  h ^= uint32_t(y) * 0xC2B2AE35u;
+  h = (h << 17) | (h >> 15);
+  h ^= uint32_t(z) * 0x27D4EB2Fu;
+  h ^= h >> 16;
+  h *= 0x7FEB352Du;
+  h ^= h >> 15;
+  h *= 0x846CA68Bu;
+  return h ^ (h >> 16);
+}
+
+// One of the 12 cube-edge directions (Perlin's improved-noise gradients).
+double corner_dot(uint32_t h, double x, double y, double z) {
+  switch (h % 12) {
+    case 0: return x + y;
+    case 1: return -x + y;
+    case 2: return x - y;
+    case 3: return -x - y;
+    case 4: return x + z;
+    case 5: return -x + z;
+    case 6: return x - z;
+    case 7: return -x - z;
+    case 8: return y + z;
+    case 9: return -y + z;
+    case 10: return y - z;
+    default: return -y - z;
+  }
+}
+
+double fade(double t) { return t * t * t * (t * (t * 6.0 - 15.0) + 10.0); }
+
+// 3D gradient noise, about [-1, 1].
+double gradient_noise(const glm::dvec3& p, uint32_t seed) {
+  glm::dvec3 f = glm::floor(p);
+  glm::ivec3 i(f);
+  glm::dvec3 t = p - f;
+  double corner[8];
+  for (int k = 0; k < 8; ++k) {
+    glm::ivec3 o(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+    glm::dvec3 d = t - glm::dvec3(o);
+    corner[k] = corner_dot(hash3(i.x + o.x, i.y + o.y, i.z + o.z, seed), d.x, d.y, d.z);
+  }
+  double u = fade(t.x), v = fade(t.y), w = fade(t.z);
+  auto lerp = [](double a, double b, double s) { return a + s * (b - a); };
+  double x00 = lerp(corner[0], corner[1], u), x10 = lerp(corner[2], corner[3], u);
+  double x01 = lerp(corner[4], corner[5], u), x11 = lerp(corner[6], corner[7], u);
+  return lerp(lerp(x00, x10, v), lerp(x01, x11, v), w);
+}
+
+// Three octaves, normalized to about [-1, 1].
+double fractal_noise(const glm::dvec3& p, uint32_t seed) {
+  return (gradient_noise(p, seed) + 0.5 * gradient_noise(2.0 * p, seed + 1) +
+          0.25 * gradient_noise(4.0 * p, seed + 2)) /
+         1.75;
+}
+
+// |x| - R (1 + amplitude * noise(direction)) in the brush's local frame: a
+// star-shaped solid, so every radial line crosses its surface once.
+class NoiseSphereSolid final : public ImplicitSolid {
+ public:
+  explicit NoiseSphereSolid(const Brush& b)
+      : n_(b.noise), transform_(b.transform), inverse_(glm::inverse(b.transform)), material_(b.material) {}
+
+  double value(const glm::dvec3& world) const override {
+    glm::dvec3 l(inverse_ * glm::dvec4(world, 1.0));
+    double r = glm::length(l);
+    if (r == 0.0) return -n_.radius;
+    return r - local_radius(l / r);
+  }
+  uint16_t material(const glm::dvec3&) const override { return material_; }
+
+  WorldBox bounds() const override {
+    double e = n_.radius * (1.0 + n_.amplitude);
+    WorldBox b{glm::dvec3(INFINITY), glm::dvec3(-INFINITY)};
+    for (int i = 0; i < 8; ++i) {
+      glm::dvec3 corner((i & 1) ? e : -e, (i & 2) ? e : -e, (i & 4) ? e : -e);
+      glm::dvec3 w(transform_ * glm::dvec4(corner, 1.0));
+      b.min = glm::min(b.min, w);
+      b.max = glm::max(b.max, w);
+    }
+    return b;
+  }
+
+  // Inside when all corners lie in the inner ball (its affine image is convex).
+  BoxClass classify(const WorldBox& box) const override {
+    WorldBox b = bounds();
+    for (int a = 0; a < 3; ++a) {
+      if (box.max[a] < b.min[a] || box.min[a] > b.max[a]) return BoxClass::kOutside;
+    }
+    const double inner = n_.radius * (1.0 - n_.amplitude);
+    for (int i = 0; i < 8; ++i) {
+      glm::dvec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
+                   (i & 4) ? box.max.z : box.min.z);
+      if (!(glm::length(glm::dvec3(inverse_ * glm::dvec4(c, 1.0))) < inner)) return BoxClass::kUnknown;
+    }
+    return BoxClass::kInside;
+  }
+
+ private:
+  double local_radius(const glm::dvec3& direction) const {
+    return n_.radius * (1.0 + n_.amplitude * fractal_noise(direction * n_.frequency, n_.seed));
+  }
+
+  NoiseSphere n_;
+  glm::dmat4 transform_, inverse_;
+  uint16_t material_;
+};
+
+}  // namespace
+
+GridConfig aligned_grid(const Lattice& lattice, int chunk_size) {
+  GridConfig g;
+  g.cell_size = lattice.cell_size;
+  g.use_origin = true;
+  g.origin = lattice.origin;
+  g.chunk_size = chunk_size;
+  g.padding = 1;
+  return g;
+}
+
+std::unique_ptr<ImplicitSolid> make_noise_sphere_solid(const Brush& brush) {
+  return std::make_unique<NoiseSphereSolid>(brush);
+}
+
+Result<World> rasterize_primitive(const Primitive& primitive, const Lattice& lattice, int chunk_size) {
+  return build_from_implicit(*make_primitive_solid(primitive), aligned_grid(lattice, chunk_size));
+}
+
+Result<World> rasterize_noise_sphere(const Brush& brush, const Lattice& lattice, int chunk_size) {
+  return build_from_implicit(NoiseSphereSolid(brush), aligned_grid(lattice, chunk_size));
+}
+
+Result<World> rasterize_mesh_brush(const Brush& brush, const Lattice& lattice, int chunk_size) {
+  TriangleMesh placed;
+  placed.positions.reserve(brush.mesh->positions.size());
+  for (const glm::dvec3& p : brush.mesh->positions) {
+    placed.positions.emplace_back(brush.transform * glm::dvec4(p, 1.0));
+  }
+  placed.triangles = brush.mesh->triangles;
+  if (glm::determinant(glm::dmat3(brush.transform)) < 0.0) {  // a mirror turns the faces inside out
+    for (glm::uvec3& t : placed.triangles) std::swap(t.y, t.z);
+  }
+  placed.triangle_material.assign(placed.triangles.size(), brush.material);
+  return build_from_mesh(placed, aligned_grid(lattice, chunk_size));
+}
+
+}  // namespace ldc::detail

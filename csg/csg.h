@@ -1,0 +1,164 @@
+// Booleans and brush edits on span lists.
+//
+// A boolean of two solids on one lattice is a merge of their points ray by
+// ray, in time linear in the points: the result is inside where the operation
+// of the two inside states says so, and a point is kept where that result
+// changes. Because the inputs agree at every lattice node and no point sits on
+// a node, the result agrees at every node too: booleans never break validate().
+//
+// Rules (documented choices):
+// - A kept point keeps the normal and material of the surface it comes from;
+//   a surface exposed by a difference (the cutter's surface inside the other
+//   solid) gets the cutter's normal reversed and the material of the span it
+//   cuts into (or BooleanConfig::cut_material); where that span has no
+//   surface on the ray segment (deep inside solid chunks) it gets material 0.
+// - Points at equal depth are taken together, so touching solids merge: two
+//   boxes sharing a face union into one solid with no surface between them.
+// - Spans and gaps thinner than BooleanConfig::sliver that lie between two
+//   lattice nodes are removed (a removed gap joins the spans around it); no
+//   lattice node changes side, so the three axes still agree.
+//
+// Brush edits apply a boolean of the world with a brush (a primitive, a
+// triangle mesh or a noisy sphere) placed by a transform, rasterized straight
+// onto the rays of the chunks it overlaps; no other chunk is read or written.
+// Every edit marks the chunks it changed dirty with a version number and
+// returns an undo handle.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "ldc/build.h"
+#include "ldc/context.h"
+#include "ldc/status.h"
+#include "ldc/world.h"
+
+namespace ldc {
+
+enum class BooleanOp { kUnion, kDifference, kIntersection };
+const char* boolean_op_name(BooleanOp op);
+
+struct BooleanConfig {
+  // Spans and gaps thinner than this, between two lattice nodes, are removed.
+  // [Units: cells] [Limit: 0 .. 0.5] [Default: 0.01]
+  double sliver = 0.01;
+  // Material of surfaces a difference exposes; -1 keeps the material of the
+  // span the cutter cuts into. [Limit: -1 .. 65535]
+  int cut_material = -1;
+};
+
+Status check_boolean_config(const BooleanConfig& config);
+
+// a op b. Both worlds must share their lattice (origin and h, to the last
+// bit) and chunk size; the result's chunk box covers both boxes (only the
+// overlap for an intersection). Parallel over chunks.
+Result<World> boolean(const World& a, const World& b, BooleanOp op, const BooleanConfig& config = {},
+                      Context* ctx = nullptr);
+
+// Builds two meshes into one lattice sized for both (`grid` as for
+// build_from_mesh, applied to their joint bounds) and combines them: what
+// `ldc boolean` does. Open, self-intersecting and non-manifold meshes are
+// accepted (their LDCs are repaired, see build_from_mesh).
+Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid,
+                           const BooleanConfig& config = {}, Context* ctx = nullptr);
+
+// --- Brushes --------------------------------------------------------------------
+
+// A sphere whose radius is displaced by fractal noise: natural-looking digging.
+struct NoiseSphere {
+  double radius = 1.0;      // mean radius [Units: m] [Limit: > 0]
+  double amplitude = 0.25;  // displacement as a fraction of the radius [Limit: 0 .. 0.9]
+  double frequency = 2.0;   // noise cycles per radius [Limit: > 0]
+  uint32_t seed = 1;
+};
+
+struct Brush {
+  enum class Shape { kPrimitive, kMesh, kNoise };
+  Shape shape = Shape::kPrimitive;
+  Primitive primitive;                       // kPrimitive (its own transform and material)
+  std::shared_ptr<const TriangleMesh> mesh;  // kMesh: the mesh, placed by `transform`
+  NoiseSphere noise;                         // kNoise: centred at `transform`'s origin
+  glm::dmat4 transform{1.0};                 // kMesh, kNoise: local -> world
+  uint16_t material = 0;                     // kMesh, kNoise: material of what it adds or paints
+
+  static Brush sphere(const glm::dvec3& centre, double radius, uint16_t material = 0);
+  static Brush box(const glm::dvec3& centre, const glm::dvec3& half_extents, uint16_t material = 0);
+  static Brush capsule(const glm::dvec3& a, const glm::dvec3& b, double radius, uint16_t material = 0);
+  static Brush cylinder(const glm::dvec3& a, const glm::dvec3& b, double radius, uint16_t material = 0);
+  static Brush noisy_sphere(const glm::dvec3& centre, const NoiseSphere& noise, uint16_t material = 0);
+  static Brush from_mesh(std::shared_ptr<const TriangleMesh> mesh, const glm::dmat4& transform,
+                         uint16_t material = 0);
+};
+
+Status check_brush(const Brush& brush);
+
+// The brush rasterized on a world's lattice and chunk grid: an LDC whose
+// chunks line up with the world's, covering the brush plus one cell.
+// Primitives and noise spheres are built like implicit solids (node signs
+// sampled; primitives get exact analytic crossings), meshes by the watertight
+// mesh builder (open or self-intersecting brush meshes are repaired). Every
+// point takes the brush's material.
+Result<World> rasterize_brush(const Brush& brush, const Lattice& lattice, int chunk_size);
+
+enum class EditOp {
+  kAdd,        // world union brush
+  kSubtract,   // world minus brush
+  kIntersect,  // world inside the brush only
+  kPaint,      // surface points inside the brush take the brush's material
+};
+const char* edit_op_name(EditOp op);
+
+struct DirtyChunk {
+  glm::ivec3 chunk{0};
+  uint64_t version = 0;   // the edit that last changed it
+  glm::ivec3 node_lo{0};  // the nodes the edits changed (a box, global node coordinates)
+  glm::ivec3 node_hi{0};  // exclusive
+};
+
+// What an edit changed, and how to take it back.
+struct EditReceipt {
+  uint64_t version = 0;
+  std::vector<glm::ivec3> changed_chunks;
+  std::shared_ptr<const struct EditSnapshot> undo;  // opaque
+};
+
+// Owns a World and applies brush edits to it. Not thread-safe; the work of one
+// call runs in parallel over chunks.
+class WorldEditor {
+ public:
+  explicit WorldEditor(World world, BooleanConfig config = {});
+
+  const World& world() const { return world_; }
+  uint64_t version() const { return version_; }
+
+  // Applies one edit. On error the world is unchanged.
+  Result<EditReceipt> apply(const Brush& brush, EditOp op, Context* ctx = nullptr);
+
+  struct Edit {
+    Brush brush;
+    EditOp op = EditOp::kSubtract;
+  };
+  // Applies edits in order, as one undo step; chunks in parallel.
+  Result<EditReceipt> apply_batch(const std::vector<Edit>& edits, Context* ctx = nullptr);
+
+  // Restores the chunks an edit changed. Undo in reverse order: refused (and
+  // nothing changes) if a later edit changed one of the same chunks.
+  Status undo(const EditReceipt& receipt);
+
+  // The chunks changed since the last call, and clears the list.
+  std::vector<DirtyChunk> take_dirty();
+
+ private:
+  World world_;
+  BooleanConfig config_;
+  uint64_t version_ = 0;
+  std::unordered_map<uint64_t, uint64_t> chunk_version_;  // chunk key -> the last edit that changed it
+  std::map<uint64_t, DirtyChunk> dirty_;                  // chunk key -> what changed since take_dirty
+};
+
+}  // namespace ldc

@@ -1,0 +1,35 @@
+// Chunk-level merges behind booleans, brush edits and painting.
+#pragma once
+
+#include <memory>
+
+#include "csg/csg.h"
+
+namespace ldc::detail {
+
+// A chunk slot as a boolean reads it: its kind, and its data when mixed.
+struct ChunkView {
+  ChunkKind kind = ChunkKind::kEmpty;
+  const Chunk* data = nullptr;
+  std::shared_ptr<const Chunk> shared;  // to hand back unchanged chunks without copying
+};
+
+ChunkView view_chunk(const World& w, const glm::ivec3& chunk);
+
+struct MergedChunk {
+  ChunkKind kind = ChunkKind::kEmpty;
+  std::shared_ptr<const Chunk> data;  // set when kind is kMixed
+  bool changed_from_a = true;         // differs from the first input
+};
+
+// a op b for one chunk slot.
+MergedChunk merge_chunk(const ChunkView& a, const ChunkView& b, BooleanOp op, const BooleanConfig& config,
+                        int chunk_size);
+
+// a with the material of its surface points inside b replaced by `material`.
+MergedChunk paint_chunk(const ChunkView& a, const ChunkView& b, uint16_t material, int chunk_size);
+
+// Stores a merged chunk into w (which must contain it).
+void store_chunk(World& w, const glm::ivec3& chunk, const MergedChunk& m);
+
+}  // namespace ldc::detail

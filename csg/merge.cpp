@@ -1,0 +1,241 @@
+// Per-ray merges: the heart of booleans and brush edits.
+#include <algorithm>
+#include <cstring>
+#include <vector>
+
+#include "csg/detail/merge.h"
+#include "ldc/detail/ray_math.h"
+
+namespace ldc::detail {
+namespace {
+
+bool apply_op(BooleanOp op, bool a, bool b) {
+  switch (op) {
+    case BooleanOp::kUnion: return a || b;
+    case BooleanOp::kDifference: return a && !b;
+    case BooleanOp::kIntersection: return a && b;
+  }
+  return false;
+}
+
+// One ray segment of a chunk family, read-only.
+struct RaySegment {
+  bool starts_inside;
+  std::span<const PackedPoint> points;
+};
+
+RaySegment segment(const RayFamily& f, int ray) { return {f.starts_inside(ray), f.points(ray)}; }
+
+// Flips a point's sense and turns its normal around (a cutter surface that a
+// difference exposes faces the other way).
+PackedPoint reversed(const PackedPoint& p, uint16_t material) {
+  PackedPoint q = p;
+  glm::dvec3 n(decode_normal(p.normal));
+  q.normal = encode_normal(-n) | (p.exits() ? 0u : kPointExitBit);
+  q.material = material;
+  return q;
+}
+
+// Collects output points and removes slivers: a point within `tolerance`
+// steps of the previous one, between the same two nodes, cancels it.
+class SliverFilter {
+ public:
+  SliverFilter(uint32_t tolerance, uint32_t steps_per_cell) : tol_(tolerance), q_(steps_per_cell) {}
+  void reset() { out_.clear(); }
+  void push(const PackedPoint& p) {
+    if (!out_.empty()) {
+      const PackedPoint& top = out_.back();
+      if (uint32_t(p.depth - top.depth) < tol_ && p.depth / q_ == top.depth / q_) {
+        out_.pop_back();
+        return;
+      }
+    }
+    out_.push_back(p);
+  }
+  const std::vector<PackedPoint>& points() const { return out_; }
+
+ private:
+  uint32_t tol_, q_;
+  std::vector<PackedPoint> out_;
+};
+
+// The material of the span of `a` that contains depth d (for surfaces a
+// difference exposes): that of the nearest point of a at or before d, else
+// the next one after it.
+uint16_t span_material(std::span<const PackedPoint> a, size_t next_a) {
+  if (next_a > 0) return a[next_a - 1].material;
+  return next_a < a.size() ? a[next_a].material : uint16_t{0};
+}
+
+// a op b along one ray segment, points into `filter`.
+void merge_ray(const RaySegment& a, const RaySegment& b, BooleanOp op, int cut_material, SliverFilter& filter) {
+  bool ia = a.starts_inside, ib = b.starts_inside, out = apply_op(op, ia, ib);
+  size_t i = 0, j = 0;
+  filter.reset();
+  while (i < a.points.size() || j < b.points.size()) {
+    uint16_t d = std::min(i < a.points.size() ? a.points[i].depth : uint16_t(0xFFFF),
+                          j < b.points.size() ? b.points[j].depth : uint16_t(0xFFFF));
+    const PackedPoint* pa = (i < a.points.size() && a.points[i].depth == d) ? &a.points[i] : nullptr;
+    const PackedPoint* pb = (j < b.points.size() && b.points[j].depth == d) ? &b.points[j] : nullptr;
+    const bool a_before = ia, b_before = ib;
+    if (pa) ia = !ia, ++i;
+    if (pb) ib = !ib, ++j;
+    bool now = apply_op(op, ia, ib);
+    if (now == out) continue;  // e.g. touching spans: one exits where the other enters
+    out = now;
+    // The point whose own move changes the result keeps its surface; a wins ties.
+    bool a_alone = pa && apply_op(op, ia, b_before) != apply_op(op, a_before, b_before);
+    if (a_alone || !pb) {
+      filter.push(*pa);  // the result moves with a: same sense, same surface
+    } else if (op == BooleanOp::kDifference) {
+      uint16_t mat = cut_material >= 0 ? uint16_t(cut_material) : span_material(a.points, i);
+      filter.push(reversed(*pb, mat));  // the cutter's surface, facing out of what remains
+    } else {
+      filter.push(*pb);
+    }
+  }
+}
+
+// Is the ray inside b at depth d? (b's state after its points before d.)
+struct StateWalker {
+  RaySegment s;
+  size_t next = 0;
+  bool inside;
+  explicit StateWalker(const RaySegment& seg) : s(seg), inside(seg.starts_inside) {}
+  bool at(uint16_t d) {
+    while (next < s.points.size() && s.points[next].depth <= d) inside = !inside, ++next;
+    return inside;
+  }
+};
+
+bool same_family(const RayFamily& x, const RayFamily& y, int c) {
+  if (x.is_uniform() || y.is_uniform()) {
+    return x.is_uniform() && y.is_uniform() && x.uniform_inside() == y.uniform_inside();
+  }
+  if (x.point_count() != y.point_count()) return false;
+  for (int r = 0; r < c * c; ++r) {
+    if (x.starts_inside(r) != y.starts_inside(r) || x.point_count(r) != y.point_count(r)) return false;
+  }
+  auto px = x.all_points(), py = y.all_points();
+  return px.empty() || std::memcmp(px.data(), py.data(), px.size_bytes()) == 0;
+}
+
+// The family of a chunk view on one axis (uniform families for uniform chunks).
+const RayFamily& family_of(const ChunkView& v, int axis, RayFamily& scratch) {
+  if (v.data) return v.data->axis[axis];
+  scratch = RayFamily::uniform(v.kind == ChunkKind::kSolid);
+  return scratch;
+}
+
+RayFamily merge_family(const RayFamily& a, const RayFamily& b, BooleanOp op, const BooleanConfig& config, int c) {
+  const uint32_t q = depth_steps_per_cell(c);
+  SliverFilter filter(uint32_t(config.sliver * q), q);
+  RayFamilyWriter wr(c);
+  for (int r = 0; r < c * c; ++r) {
+    RaySegment sa = segment(a, r), sb = segment(b, r);
+    wr.begin_ray(apply_op(op, sa.starts_inside, sb.starts_inside));
+    if (sb.points.empty() && sa.points.empty()) continue;
+    merge_ray(sa, sb, op, config.cut_material, filter);
+    for (const PackedPoint& p : filter.points()) wr.add_point(p);
+  }
+  return wr.finish();
+}
+
+// Three result families, each either one of a's (not copied) or new.
+struct FamilyChoice {
+  std::array<const RayFamily*, 3> pick{};
+  std::array<RayFamily, 3> owned;
+  bool unchanged = true;
+};
+
+MergedChunk finish_chunk(FamilyChoice& f, const ChunkView& a) {
+  MergedChunk m;
+  if (f.unchanged) {
+    m.kind = a.kind;
+    m.data = a.shared;
+    m.changed_from_a = false;
+    return m;
+  }
+  auto chunk = std::make_shared<Chunk>();
+  for (int k = 0; k < 3; ++k) chunk->axis[k] = f.pick[k] == &f.owned[k] ? std::move(f.owned[k]) : *f.pick[k];
+  bool inside = false;
+  if (chunk->is_uniform(&inside)) {
+    m.kind = inside ? ChunkKind::kSolid : ChunkKind::kEmpty;
+  } else {
+    m.kind = ChunkKind::kMixed;
+    m.data = std::move(chunk);
+  }
+  m.changed_from_a = true;
+  return m;
+}
+
+}  // namespace
+
+ChunkView view_chunk(const World& w, const glm::ivec3& chunk) {
+  ChunkView v;
+  v.kind = w.chunk_kind(chunk);
+  v.shared = w.chunk_shared(chunk);
+  v.data = v.shared.get();
+  return v;
+}
+
+MergedChunk merge_chunk(const ChunkView& a, const ChunkView& b, BooleanOp op, const BooleanConfig& config,
+                        int c) {
+  FamilyChoice f;
+  std::array<RayFamily, 3> scratch_a, scratch_b;
+  for (int k = 0; k < 3; ++k) {
+    const RayFamily& fa = family_of(a, k, scratch_a[k]);
+    const RayFamily& fb = family_of(b, k, scratch_b[k]);
+    if (fb.is_uniform()) {  // b decides alone: keep a, or make it uniform
+      bool keep_a = (op == BooleanOp::kIntersection) == fb.uniform_inside();
+      if (keep_a) {
+        f.pick[k] = &fa;
+        continue;
+      }
+      bool solid = op == BooleanOp::kUnion;
+      f.owned[k] = RayFamily::uniform(solid);
+      f.unchanged = f.unchanged && fa.is_uniform() && fa.uniform_inside() == solid;
+    } else {
+      f.owned[k] = merge_family(fa, fb, op, config, c);
+      f.unchanged = f.unchanged && same_family(f.owned[k], fa, c);
+    }
+    f.pick[k] = &f.owned[k];
+  }
+  return finish_chunk(f, a);
+}
+
+MergedChunk paint_chunk(const ChunkView& a, const ChunkView& b, uint16_t material, int c) {
+  FamilyChoice f;
+  std::array<RayFamily, 3> scratch_a, scratch_b;
+  for (int k = 0; k < 3; ++k) {
+    const RayFamily& fa = family_of(a, k, scratch_a[k]);
+    const RayFamily& fb = family_of(b, k, scratch_b[k]);
+    f.pick[k] = &fa;
+    if (fa.is_uniform() || (fb.is_uniform() && !fb.uniform_inside())) continue;  // nothing to paint
+    RayFamilyWriter wr(c);
+    bool changed = false;
+    for (int r = 0; r < c * c; ++r) {
+      wr.begin_ray(fa.starts_inside(r));
+      StateWalker inside_b(segment(fb, r));
+      for (PackedPoint p : fa.points(r)) {
+        if (inside_b.at(p.depth) && p.material != material) {
+          p.material = material;
+          changed = true;
+        }
+        wr.add_point(p);
+      }
+    }
+    if (!changed) continue;
+    f.owned[k] = wr.finish();
+    f.pick[k] = &f.owned[k];
+    f.unchanged = false;
+  }
+  return finish_chunk(f, a);
+}
+
+void store_chunk(World& w, const glm::ivec3& chunk, const MergedChunk& m) {
+  if (m.kind == ChunkKind::kMixed) w.set_chunk(chunk, m.data);
+  else w.set_uniform_chunk(chunk, m.kind == ChunkKind::kSolid);
+}
+
+}  // namespace ldc::detail
