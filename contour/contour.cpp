@@ -147,16 +147,33 @@ Status ChunkedMesh::build(const World& world, Context* ctx) {
 }
 
 Result<size_t> ChunkedMesh::update(const World& world, const std::vector<glm::ivec3>& changed, Context* ctx) {
+  // A chunk's mesh reads its region: the chunk and a margin into all 26 neighbours.
+  const int c = world.chunk_size();
+  std::vector<DirtyChunk> whole;
+  whole.reserve(changed.size());
+  for (const glm::ivec3& ch : changed) whole.push_back({ch, 0, ch * c, ch * c + c});
+  return update(world, whole, ctx);
+}
+
+Result<size_t> ChunkedMesh::update(const World& world, const std::vector<DirtyChunk>& dirty, Context* ctx) {
   if (world.chunk_size() != chunk_size_) {
     return Status(ErrorCode::kInvalidArgument, "contour: update with a world of another chunk size");
   }
-  // A chunk's mesh reads its region: the chunk and a margin into all 26 neighbours.
+  // Chunk k reads nodes [k*C - M, k*C + C + M): the cells one below its own for
+  // quads, and relax_iterations more on every side where materials meet.
+  const int c = chunk_size_, margin = config_.relax_iterations + 1;
   auto less = [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); };
   std::set<glm::ivec3, decltype(less)> todo(less);
-  for (const glm::ivec3& c : changed)
-    for (int dz = -1; dz <= 1; ++dz)
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) todo.insert(c + glm::ivec3(dx, dy, dz));
+  for (const DirtyChunk& d : dirty) {
+    glm::ivec3 lo, hi;
+    for (int a = 0; a < 3; ++a) {
+      lo[a] = detail::floor_div(d.node_lo[a] - margin, c);
+      hi[a] = detail::floor_div(d.node_hi[a] + margin + c - 1, c);
+    }
+    for (int z = lo.z; z < hi.z; ++z)
+      for (int y = lo.y; y < hi.y; ++y)
+        for (int x = lo.x; x < hi.x; ++x) todo.insert({x, y, z});
+  }
   std::vector<glm::ivec3> list(todo.begin(), todo.end());
   ContourStats stats;
   Result<std::vector<ChunkMesh>> r = mesh_chunks(world, list, config_, ctx, stats);

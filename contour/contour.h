@@ -147,6 +147,11 @@ class ChunkedMesh {
   // chunks were re-meshed.
   Result<size_t> update(const World& world, const std::vector<glm::ivec3>& changed_chunks,
                         Context* ctx = nullptr);
+  // Re-meshes only the chunks whose meshes read a node in one of the dirty
+  // boxes (a chunk reads its own nodes and relax_iterations + 1 more on every
+  // side): an edit inside a chunk re-meshes that chunk alone. Returns how
+  // many chunks were re-meshed.
+  Result<size_t> update(const World& world, const std::vector<DirtyChunk>& dirty, Context* ctx = nullptr);
   const std::vector<ChunkMesh>& chunks() const { return chunks_; }
   // One welded mesh: every vertex once, chunk by chunk, in a fixed order.
   ContourMesh assemble() const;

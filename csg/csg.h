@@ -113,13 +113,6 @@ enum class EditOp {
 };
 const char* edit_op_name(EditOp op);
 
-struct DirtyChunk {
-  glm::ivec3 chunk{0};
-  uint64_t version = 0;   // the edit that last changed it
-  glm::ivec3 node_lo{0};  // the nodes the edits changed (a box, global node coordinates)
-  glm::ivec3 node_hi{0};  // exclusive
-};
-
 // What an edit changed, and how to take it back.
 struct EditReceipt {
   uint64_t version = 0;

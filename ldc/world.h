@@ -297,6 +297,16 @@ class World {
   std::vector<std::pair<std::string, std::string>> metadata_;
 };
 
+// A chunk an edit changed (WorldEditor::take_dirty lists them, and
+// ChunkedMesh::update re-meshes from them): which edit, and the box of lattice
+// nodes around which its rays or node states may differ, clipped to the chunk.
+struct DirtyChunk {
+  glm::ivec3 chunk{0};
+  uint64_t version = 0;   // the edit that last changed it
+  glm::ivec3 node_lo{0};  // global node coordinates
+  glm::ivec3 node_hi{0};  // exclusive
+};
+
 // Decodes a packed point of the ray segment starting at global depth `segment_start`.
 SurfacePoint decode_point(const PackedPoint& p, int chunk_size, int segment_start);
 

@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "csg/csg.h"
+#include "contour/contour.h"
 #include "csg/detail/brush_raster.h"
 #include "test_util.h"
 
@@ -237,11 +238,11 @@ TEST(MeshBoolean, OpenBunnyMinusSphereIsValid) {
 
 // --- Brushes and the editor --------------------------------------------------
 
-// A slab of ground 8 x 8 x 2 m at h = 0.2 (chunks of 16 cells), material 1.
-World ground() {
+// A slab of ground 2 half_width x 2 half_width x 2 m at h = 0.2 (chunks of 16 cells), material 1.
+World ground(double half_width = 4.0) {
   Primitive slab;
   slab.shape = Primitive::Shape::kBox;
-  slab.half_extents = glm::dvec3(4.0, 4.0, 1.0);
+  slab.half_extents = glm::dvec3(half_width, half_width, 1.0);
   slab.material = 1;
   GridConfig grid{.cell_size = 0.2, .chunk_size = 16, .use_origin = true, .origin = glm::dvec3(-4.9, -4.9, -1.9)};
   return build_from_primitive(slab, grid).value();
@@ -441,6 +442,51 @@ TEST(Editor, ErrorsLeaveTheWorldAsItWas) {
   EXPECT_EQ(ed.version(), 0u);
   EXPECT_TRUE(identical(ed.world(), original));
   EXPECT_TRUE(ed.take_dirty().empty());
+}
+
+// Chunk meshes equal, vertex for vertex.
+::testing::AssertionResult same_meshes(const ChunkedMesh& a, const ChunkedMesh& b) {
+  if (a.chunks().size() != b.chunks().size()) {
+    return ::testing::AssertionFailure() << a.chunks().size() << " vs " << b.chunks().size() << " chunk meshes";
+  }
+  for (size_t i = 0; i < a.chunks().size(); ++i) {
+    const ChunkMesh &x = a.chunks()[i], &y = b.chunks()[i];
+    if (x.chunk != y.chunk || x.mesh.positions != y.mesh.positions || x.mesh.triangles != y.mesh.triangles ||
+        x.mesh.triangle_material != y.mesh.triangle_material) {
+      return ::testing::AssertionFailure() << "chunk mesh " << i << " differs";
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+TEST(Editor, DirtyBoxesRemeshExactlyWhatAFreshBuildWould) {
+  WorldEditor ed(ground(8.0));
+  ChunkedMesh incremental;
+  ASSERT_TRUE(incremental.build(ed.world()).ok());
+  std::vector<WorldEditor::Edit> edits = {
+      {Brush::sphere({0.0, 0.0, 1.0}, 0.7), EditOp::kSubtract},           // inside a chunk ...
+      {Brush::sphere({-1.7, -1.7, 1.0}, 0.5, 2), EditOp::kPaint},         // ... and near chunk corners
+      {Brush::box({1.5, 1.55, 1.2}, glm::dvec3(0.4), 3), EditOp::kAdd},
+      {Brush::noisy_sphere({-1.6, 1.6, 0.9}, {.radius = 0.6}), EditOp::kSubtract},
+  };
+  // Then small random edits of every kind centred near chunk faces (x, y = -1.7 or 1.5).
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> jitter(-0.9, 0.9), unit(0.0, 1.0);
+  for (int i = 0; i < 24; ++i) {
+    glm::dvec3 c((rng() % 2 ? 1.5 : -1.7) + jitter(rng), (rng() % 2 ? 1.5 : -1.7) + jitter(rng), 1.0 + 0.5 * jitter(rng));
+    EditOp op = std::array{EditOp::kAdd, EditOp::kSubtract, EditOp::kPaint}[rng() % 3];
+    edits.push_back({Brush::sphere(c, 0.1 + 0.5 * unit(rng), uint16_t(rng() % 3)), op});
+  }
+  size_t chunks = size_t(ed.world().chunk_dims().x) * ed.world().chunk_dims().y * ed.world().chunk_dims().z;
+  for (const auto& e : edits) {
+    ASSERT_TRUE(ed.apply(e.brush, e.op).ok());
+    Result<size_t> n = incremental.update(ed.world(), ed.take_dirty());
+    ASSERT_TRUE(n.ok()) << n.status().message();
+    EXPECT_LE(n.value(), chunks / 4);
+    ChunkedMesh fresh;
+    ASSERT_TRUE(fresh.build(ed.world()).ok());
+    EXPECT_TRUE(same_meshes(incremental, fresh)) << edit_op_name(e.op);
+  }
 }
 
 // Random brushes of every shape, size and op, many placed on lattice nodes or
