@@ -60,7 +60,6 @@ struct PreparedEdit {
   EditOp op = EditOp::kSubtract;
   uint16_t material = 0;
   glm::ivec3 solid_chunk_lo{0}, solid_chunk_hi{0};  // chunks where the brush holds solid (hi exclusive)
-  glm::ivec3 node_lo{0}, node_hi{0};                // nodes the edit can change (hi exclusive)
   bool empty = true;                                // the brush holds no solid on this lattice
 };
 
@@ -81,11 +80,6 @@ Result<PreparedEdit> prepare_edit(const WorldEditor::Edit& e, const World& world
   if (p.empty) return p;
   p.solid_chunk_lo = lo;
   p.solid_chunk_hi = hi;
-  // Points can change only on rays through nodes next to the brush's solid.
-  std::optional<WorldBox> b = p.brush.solid_bounds();
-  const Lattice& lat = world.lattice();
-  p.node_lo = glm::ivec3(glm::floor(lat.to_lattice(b->min))) - 1;
-  p.node_hi = glm::ivec3(glm::ceil(lat.to_lattice(b->max))) + 2;
   return p;
 }
 
@@ -122,7 +116,7 @@ ChunkOutcome edit_chunk(const World& world, const glm::ivec3& c, const std::vect
                         const BooleanConfig& config) {
   using namespace detail;
   const int size = world.chunk_size();
-  const glm::ivec3 chunk_lo = c * size, chunk_hi = chunk_lo + size;
+  const glm::ivec3 chunk_lo = c * size;
   ChunkView current = view_chunk(world, c);
   ChunkOutcome out;
   out.merged.kind = current.kind;
@@ -136,11 +130,8 @@ ChunkOutcome edit_chunk(const World& world, const glm::ivec3& c, const std::vect
     out.changed = true;
     out.merged = m;
     current = ChunkView{m.kind, m.data.get(), m.data};
-    // An intersection empties chunks far from its brush: all their nodes change.
-    bool near = !e.empty && glm::all(glm::lessThan(e.node_lo, chunk_hi)) &&
-                glm::all(glm::greaterThan(e.node_hi, chunk_lo));
-    out.node_lo = glm::min(out.node_lo, near ? glm::max(e.node_lo, chunk_lo) : chunk_lo);
-    out.node_hi = glm::max(out.node_hi, near ? glm::min(e.node_hi, chunk_hi) : chunk_hi);
+    out.node_lo = glm::min(out.node_lo, chunk_lo + m.changed.lo);
+    out.node_hi = glm::max(out.node_hi, chunk_lo + m.changed.hi);
   }
   return out;
 }

@@ -1,6 +1,6 @@
 // Per-ray merges: the heart of booleans and brush edits.
 #include <algorithm>
-#include <cstring>
+#include <climits>
 #include <vector>
 
 #include "csg/detail/merge.h"
@@ -108,16 +108,39 @@ struct StateWalker {
   }
 };
 
-bool same_family(const RayFamily& x, const RayFamily& y, int c) {
-  if (x.is_uniform() || y.is_uniform()) {
-    return x.is_uniform() && y.is_uniform() && x.uniform_inside() == y.uniform_inside();
+bool same_point(const PackedPoint& x, const PackedPoint& y) {
+  return x.depth == y.depth && x.material == y.material && x.normal == y.normal;
+}
+
+// Adds to `box` the nodes around the points where one ray segment changed
+// from `a` to `out`: the differing middle once equal heads and tails are cut off.
+void note_ray_change(const RaySegment& a, const RaySegment& out, int axis, int ray, int c, ChangeBox& box) {
+  const uint32_t q = depth_steps_per_cell(c);
+  const bool flipped = a.starts_inside != out.starts_inside;  // every node before the first change flips
+  size_t i = 0, ja = a.points.size(), jo = out.points.size();
+  if (!flipped) {
+    while (i < ja && i < jo && same_point(a.points[i], out.points[i])) ++i;
+    if (i == ja && i == jo) return;
   }
-  if (x.point_count() != y.point_count()) return false;
-  for (int r = 0; r < c * c; ++r) {
-    if (x.starts_inside(r) != y.starts_inside(r) || x.point_count(r) != y.point_count(r)) return false;
-  }
-  auto px = x.all_points(), py = y.all_points();
-  return px.empty() || std::memcmp(px.data(), py.data(), px.size_bytes()) == 0;
+  while (ja > i && jo > i && same_point(a.points[ja - 1], out.points[jo - 1])) --ja, --jo;
+  uint32_t first = UINT32_MAX, last = 0;
+  if (i < ja) first = a.points[i].depth, last = a.points[ja - 1].depth;
+  if (i < jo) first = std::min<uint32_t>(first, out.points[i].depth), last = std::max<uint32_t>(last, out.points[jo - 1].depth);
+  int n0 = flipped ? 0 : int(first / q);
+  int n1 = i < ja || i < jo ? int(last / q) + 2 : c + 1;  // a flip with equal points: the whole segment
+  glm::ivec3 lo, hi;
+  lo[axis] = n0;
+  hi[axis] = n1;
+  lo[axis_u(axis)] = ray % c;
+  hi[axis_u(axis)] = ray % c + 1;
+  lo[axis_v(axis)] = ray / c;
+  hi[axis_v(axis)] = ray / c + 1;
+  box.add(lo, hi);
+}
+
+void note_family_change(const RayFamily& a, const RayFamily& out, int axis, int c, ChangeBox& box) {
+  if (a.is_uniform() && out.is_uniform() && a.uniform_inside() == out.uniform_inside()) return;
+  for (int r = 0; r < c * c; ++r) note_ray_change(segment(a, r), segment(out, r), axis, r, c, box);
 }
 
 // The family of a chunk view on one axis (uniform families for uniform chunks).
@@ -145,12 +168,13 @@ RayFamily merge_family(const RayFamily& a, const RayFamily& b, BooleanOp op, con
 struct FamilyChoice {
   std::array<const RayFamily*, 3> pick{};
   std::array<RayFamily, 3> owned;
-  bool unchanged = true;
+  ChangeBox changed;
 };
 
 MergedChunk finish_chunk(FamilyChoice& f, const ChunkView& a) {
   MergedChunk m;
-  if (f.unchanged) {
+  m.changed = f.changed;
+  if (f.changed.empty()) {
     m.kind = a.kind;
     m.data = a.shared;
     m.changed_from_a = false;
@@ -192,13 +216,11 @@ MergedChunk merge_chunk(const ChunkView& a, const ChunkView& b, BooleanOp op, co
         f.pick[k] = &fa;
         continue;
       }
-      bool solid = op == BooleanOp::kUnion;
-      f.owned[k] = RayFamily::uniform(solid);
-      f.unchanged = f.unchanged && fa.is_uniform() && fa.uniform_inside() == solid;
+      f.owned[k] = RayFamily::uniform(op == BooleanOp::kUnion);
     } else {
       f.owned[k] = merge_family(fa, fb, op, config, c);
-      f.unchanged = f.unchanged && same_family(f.owned[k], fa, c);
     }
+    note_family_change(fa, f.owned[k], k, c, f.changed);
     f.pick[k] = &f.owned[k];
   }
   return finish_chunk(f, a);
@@ -228,7 +250,7 @@ MergedChunk paint_chunk(const ChunkView& a, const ChunkView& b, uint16_t materia
     if (!changed) continue;
     f.owned[k] = wr.finish();
     f.pick[k] = &f.owned[k];
-    f.unchanged = false;
+    note_family_change(fa, f.owned[k], k, c, f.changed);
   }
   return finish_chunk(f, a);
 }

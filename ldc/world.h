@@ -299,7 +299,9 @@ class World {
 
 // A chunk an edit changed (WorldEditor::take_dirty lists them, and
 // ChunkedMesh::update re-meshes from them): which edit, and the box of lattice
-// nodes around which its rays or node states may differ, clipped to the chunk.
+// nodes whose state, or whose cell edges' crossings, changed in the chunk's
+// rays (both ends of each changed edge: the box may hold the first node of
+// the next chunk).
 struct DirtyChunk {
   glm::ivec3 chunk{0};
   uint64_t version = 0;   // the edit that last changed it

@@ -324,10 +324,10 @@ TEST(Editor, DigChangesOnlyTheChunksItTouches) {
     EXPECT_EQ(d.version, 1u);
     for (int a = 0; a < 3; ++a) {
       EXPECT_LT(d.node_lo[a], d.node_hi[a]);
-      EXPECT_GE(d.node_lo[a], std::floor(centre[a] - 4.0 - 2.0));
-      EXPECT_LE(d.node_hi[a], std::ceil(centre[a] + 4.0 + 3.0));
+      EXPECT_GE(d.node_lo[a], std::floor(centre[a] - 4.0));  // the brush's radius is 4 cells
+      EXPECT_LE(d.node_hi[a], std::ceil(centre[a] + 4.0) + 2);
       EXPECT_GE(d.node_lo[a], d.chunk[a] * 16);
-      EXPECT_LE(d.node_hi[a], d.chunk[a] * 16 + 16);
+      EXPECT_LE(d.node_hi[a], d.chunk[a] * 16 + 17);
     }
   }
   EXPECT_TRUE(ed.take_dirty().empty());

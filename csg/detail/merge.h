@@ -1,6 +1,8 @@
 // Chunk-level merges behind booleans, brush edits and painting.
 #pragma once
 
+#include <climits>
+#include <cstdint>
 #include <memory>
 
 #include "csg/csg.h"
@@ -16,10 +18,23 @@ struct ChunkView {
 
 ChunkView view_chunk(const World& w, const glm::ivec3& chunk);
 
+// Chunk-local lattice nodes around the points a merge changed: both nodes of
+// every cell edge whose crossings changed (so hi may reach C + 1).
+struct ChangeBox {
+  glm::ivec3 lo{INT32_MAX};
+  glm::ivec3 hi{INT32_MIN};  // exclusive
+  bool empty() const { return lo.x >= hi.x; }
+  void add(const glm::ivec3& node_lo, const glm::ivec3& node_hi) {
+    lo = glm::min(lo, node_lo);
+    hi = glm::max(hi, node_hi);
+  }
+};
+
 struct MergedChunk {
   ChunkKind kind = ChunkKind::kEmpty;
   std::shared_ptr<const Chunk> data;  // set when kind is kMixed
   bool changed_from_a = true;         // differs from the first input
+  ChangeBox changed;                  // where, when changed_from_a
 };
 
 // a op b for one chunk slot.
