@@ -84,12 +84,21 @@ nlohmann::json world_info_json(const World& world, bool run_validate) {
   nlohmann::json meta = nlohmann::json::object();
   for (const auto& [k, v] : world.metadata()) meta[k] = v;
   j["metadata"] = meta;
-  if (run_validate) {
-    ValidationReport r = validate(world);
-    j["validation"] = {{"ok", r.ok}, {"errors", r.errors}, {"nodes_checked", r.nodes_checked},
-                       {"messages", r.messages}};
-  }
+  if (run_validate) j["validation"] = validation_json(world);
   return j;
+}
+
+nlohmann::json validation_json(const World& world) {
+  ValidationReport r = validate(world);
+  return {{"ok", r.ok}, {"errors", r.errors}, {"nodes_checked", r.nodes_checked}, {"messages", r.messages}};
+}
+
+std::string validation_text(const nlohmann::json& v) {
+  std::ostringstream s;
+  s << "validation  " << (v["ok"].get<bool>() ? "valid" : "INVALID") << " (" << v["errors"] << " errors, "
+    << v["nodes_checked"] << " nodes checked across axes)\n";
+  for (const auto& m : v["messages"]) s << "  " << m.get<std::string>() << "\n";
+  return s.str();
 }
 
 std::string world_info_text(const nlohmann::json& j) {
@@ -114,13 +123,12 @@ std::string world_info_text(const nlohmann::json& j) {
     s << "solid       (" << v3(j["solid_bounds"]["min"]) << ") .. (" << v3(j["solid_bounds"]["max"]) << ")\n";
   }
   for (const auto& [k, v] : j["metadata"].items()) s << "  " << k << ": " << v.get<std::string>() << "\n";
-  if (j.contains("validation")) {
-    const auto& v = j["validation"];
-    s << "validation  " << (v["ok"].get<bool>() ? "valid" : "INVALID") << " (" << v["errors"]
-      << " errors, " << v["nodes_checked"] << " nodes checked across axes)\n";
-    for (const auto& m : v["messages"]) s << "  " << m.get<std::string>() << "\n";
-  }
+  if (j.contains("validation")) s << validation_text(j["validation"]);
   return s.str();
+}
+
+void print_seconds(const nlohmann::json& seconds) {
+  for (const auto& [stage, s] : seconds.items()) std::printf("  %s: %.3f s\n", stage.c_str(), s.get<double>());
 }
 
 void set_thread_count(int threads) {

@@ -55,6 +55,13 @@ nlohmann::json world_info_json(const World& world, bool run_validate);
 // The same, as human-readable lines.
 std::string world_info_text(const nlohmann::json& info);
 
+// validate() as JSON {"ok", "errors", "nodes_checked", "messages"}, and as text.
+nlohmann::json validation_json(const World& world);
+std::string validation_text(const nlohmann::json& validation);
+
+// "  <stage>: <seconds> s", one line per entry of a {"stage": seconds} object.
+void print_seconds(const nlohmann::json& seconds);
+
 // Limits the TBB worker threads for the rest of the process (0 = all).
 void set_thread_count(int threads);
 
@@ -64,5 +71,7 @@ void add_info_command(CLI::App& app, CommonOptions& common);
 void add_inside_command(CLI::App& app, CommonOptions& common);
 void add_terrain_command(CLI::App& app, CommonOptions& common);
 void add_contour_commands(CLI::App& app, CommonOptions& common);
+void add_boolean_command(CLI::App& app, CommonOptions& common);
+void add_edit_command(CLI::App& app, CommonOptions& common);
 
 }  // namespace ldc::tool

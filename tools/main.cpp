@@ -18,6 +18,8 @@ int main(int argc, char** argv) {
   ldc::tool::add_inside_command(app, common);
   ldc::tool::add_terrain_command(app, common);
   ldc::tool::add_contour_commands(app, common);
+  ldc::tool::add_boolean_command(app, common);
+  ldc::tool::add_edit_command(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,0 +1,293 @@
+#include "edit_script.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+#include <glm/gtc/matrix_transform.hpp>
+#include <nlohmann/json.hpp>
+
+namespace ldc::tool {
+
+const char* const kEditScriptHelp = R"(Script (JSON): {"edits": [ edit, ... ]}, applied in order. Every edit has
+  "op": add | subtract | intersect | paint, "brush": one of the below,
+  "material": id 0..65535 (optional, default 0), and the brush's fields:
+  sphere    "centre": [x,y,z], "radius": r
+  box       "centre": [x,y,z], "half_extents": [x,y,z]
+  capsule   "a": [x,y,z], "b": [x,y,z], "radius": r
+  cylinder  "a": [x,y,z], "b": [x,y,z], "radius": r
+  noise     "centre": [x,y,z], "radius": r, optional "amplitude" (0.25), "frequency" (2), "seed" (1)
+  mesh      "mesh": file (relative to the script's folder), optional "translate": [x,y,z],
+            "scale": s (uniform, 1)
+  sphere, box, noise and mesh also take optional "rotate_deg" (0) about "axis" ([0,0,1]),
+  turning the brush about its centre (a mesh about its own origin, before "translate").
+Unknown fields are refused. Example:
+  {"edits": [{"op": "subtract", "brush": "sphere", "centre": [0,0,1], "radius": 1.5},
+             {"op": "paint", "brush": "box", "centre": [2,0,1], "half_extents": [1,1,1],
+              "rotate_deg": 30, "axis": [0,0,1], "material": 3}]}
+)";
+
+namespace {
+
+// The fields of one edit, read with their checks. The first error is kept and
+// later reads return defaults, so a brush reads as straight-line code that is
+// checked once at the end.
+class EditFields {
+ public:
+  EditFields(const nlohmann::json& edit, size_t index) : edit_(edit), index_(index) {}
+
+  const Status& error() const { return error_; }
+  void fail(const std::string& field, const std::string& problem) {
+    if (!error_.ok()) return;
+    error_ = Status(ErrorCode::kInvalidArgument, "edit " + std::to_string(index_) + ": field '" + field + "' " + problem);
+  }
+
+  std::string text(const char* name) {
+    const nlohmann::json* v = find(name, true);
+    if (v && !v->is_string()) fail(name, std::string("must be a string, not ") + v->type_name());
+    return v && v->is_string() ? v->get<std::string>() : std::string();
+  }
+  double number(const char* name) {
+    const nlohmann::json* v = find(name, true);
+    return v ? to_number(name, *v) : 0.0;
+  }
+  double number_or(const char* name, double fallback) {
+    const nlohmann::json* v = find(name, false);
+    return v ? to_number(name, *v) : fallback;
+  }
+  uint32_t integer_or(const char* name, uint32_t fallback, uint32_t max) {
+    const nlohmann::json* v = find(name, false);
+    if (!v) return fallback;
+    double d = to_number(name, *v);
+    if (d >= 0.0 && d <= double(max) && std::floor(d) == d) return uint32_t(d);
+    fail(name, "must be a whole number in 0 .. " + std::to_string(max));
+    return fallback;
+  }
+  glm::dvec3 vec3(const char* name) {
+    const nlohmann::json* v = find(name, true);
+    return v ? to_vec3(name, *v) : glm::dvec3(0.0);
+  }
+  glm::dvec3 vec3_or(const char* name, const glm::dvec3& fallback) {
+    const nlohmann::json* v = find(name, false);
+    return v ? to_vec3(name, *v) : fallback;
+  }
+
+ private:
+  const nlohmann::json* find(const char* name, bool required) {
+    auto it = edit_.find(name);
+    if (it != edit_.end()) return &*it;
+    if (required) fail(name, "is missing");
+    return nullptr;
+  }
+  double to_number(const char* name, const nlohmann::json& v) {
+    if (!v.is_number()) fail(name, std::string("must be a number, not ") + v.type_name());
+    double d = v.is_number() ? v.get<double>() : 0.0;
+    if (!std::isfinite(d)) fail(name, "must be a finite number");
+    return std::isfinite(d) ? d : 0.0;
+  }
+  glm::dvec3 to_vec3(const char* name, const nlohmann::json& v) {
+    if (!v.is_array() || v.size() != 3) {
+      fail(name, "must be an array of three numbers [x, y, z]");
+      return glm::dvec3(0.0);
+    }
+    return {to_number(name, v[0]), to_number(name, v[1]), to_number(name, v[2])};
+  }
+
+  const nlohmann::json& edit_;
+  size_t index_;
+  Status error_;
+};
+
+// Mesh brushes' files, each loaded once however many edits use it.
+class MeshFiles {
+ public:
+  explicit MeshFiles(std::filesystem::path folder) : folder_(std::move(folder)) {}
+  std::shared_ptr<const TriangleMesh> load(const std::string& file, EditFields& f) {
+    std::filesystem::path path(file);
+    if (path.is_relative()) path = folder_ / path;  // relative to the script, not the working folder
+    auto found = meshes_.find(path.string());
+    if (found != meshes_.end()) return found->second;
+    Result<TriangleMesh> mesh = load_mesh(path.string());
+    if (!mesh.ok()) {
+      f.fail("mesh", "('" + file + "'): " + mesh.status().to_string());
+      return nullptr;
+    }
+    auto shared = std::make_shared<const TriangleMesh>(std::move(mesh).value());
+    meshes_.emplace(path.string(), shared);
+    return shared;
+  }
+
+ private:
+  std::filesystem::path folder_;
+  std::map<std::string, std::shared_ptr<const TriangleMesh>> meshes_;
+};
+
+// Optional "rotate_deg" about "axis". Composed on the local side of a brush's
+// transform, so the brush turns about its own centre (a mesh about its origin).
+glm::dmat4 rotation(EditFields& f) {
+  double degrees = f.number_or("rotate_deg", 0.0);
+  glm::dvec3 axis = f.vec3_or("axis", glm::dvec3(0.0, 0.0, 1.0));
+  if (glm::length(axis) == 0.0) {
+    f.fail("axis", "must not be zero");
+    return glm::dmat4(1.0);
+  }
+  return glm::rotate(glm::dmat4(1.0), glm::radians(degrees), glm::normalize(axis));
+}
+
+Brush sphere_brush(EditFields& f, uint16_t material, MeshFiles&) {
+  glm::dvec3 centre = f.vec3("centre");
+  double radius = f.number("radius");
+  Brush b = Brush::sphere(centre, radius, material);
+  b.primitive.transform = b.primitive.transform * rotation(f);
+  return b;
+}
+
+Brush box_brush(EditFields& f, uint16_t material, MeshFiles&) {
+  glm::dvec3 centre = f.vec3("centre");
+  glm::dvec3 half_extents = f.vec3("half_extents");
+  Brush b = Brush::box(centre, half_extents, material);
+  b.primitive.transform = b.primitive.transform * rotation(f);
+  return b;
+}
+
+Brush capsule_brush(EditFields& f, uint16_t material, MeshFiles&) {
+  glm::dvec3 a = f.vec3("a"), b = f.vec3("b");
+  return Brush::capsule(a, b, f.number("radius"), material);
+}
+
+Brush cylinder_brush(EditFields& f, uint16_t material, MeshFiles&) {
+  glm::dvec3 a = f.vec3("a"), b = f.vec3("b");
+  return Brush::cylinder(a, b, f.number("radius"), material);
+}
+
+Brush noise_brush(EditFields& f, uint16_t material, MeshFiles&) {
+  glm::dvec3 centre = f.vec3("centre");
+  NoiseSphere noise;
+  noise.radius = f.number("radius");
+  noise.amplitude = f.number_or("amplitude", noise.amplitude);
+  noise.frequency = f.number_or("frequency", noise.frequency);
+  noise.seed = f.integer_or("seed", noise.seed, UINT32_MAX);
+  Brush b = Brush::noisy_sphere(centre, noise, material);
+  b.transform = b.transform * rotation(f);
+  return b;
+}
+
+Brush mesh_brush(EditFields& f, uint16_t material, MeshFiles& files) {
+  std::string file = f.text("mesh");
+  glm::dvec3 translate = f.vec3_or("translate", glm::dvec3(0.0));
+  double scale = f.number_or("scale", 1.0);
+  if (!(scale > 0.0)) f.fail("scale", "must be > 0");
+  glm::dmat4 transform = glm::translate(glm::dmat4(1.0), translate) * rotation(f);
+  transform = glm::scale(transform, glm::dvec3(scale));
+  std::shared_ptr<const TriangleMesh> mesh = f.error().ok() ? files.load(file, f) : nullptr;
+  return Brush::from_mesh(std::move(mesh), transform, material);
+}
+
+struct BrushKind {
+  const char* name;
+  std::vector<std::string> fields;  // besides op, brush and material
+  Brush (*read)(EditFields&, uint16_t material, MeshFiles&);
+};
+
+const BrushKind* find_brush_kind(const std::string& name) {
+  static const BrushKind kinds[] = {
+      {"sphere", {"centre", "radius", "rotate_deg", "axis"}, sphere_brush},
+      {"box", {"centre", "half_extents", "rotate_deg", "axis"}, box_brush},
+      {"capsule", {"a", "b", "radius"}, capsule_brush},
+      {"cylinder", {"a", "b", "radius"}, cylinder_brush},
+      {"noise", {"centre", "radius", "amplitude", "frequency", "seed", "rotate_deg", "axis"}, noise_brush},
+      {"mesh", {"mesh", "translate", "scale", "rotate_deg", "axis"}, mesh_brush},
+  };
+  for (const BrushKind& k : kinds) {
+    if (name == k.name) return &k;
+  }
+  return nullptr;
+}
+
+std::optional<EditOp> find_edit_op(const std::string& name) {
+  for (EditOp op : {EditOp::kAdd, EditOp::kSubtract, EditOp::kIntersect, EditOp::kPaint}) {
+    if (name == edit_op_name(op)) return op;
+  }
+  return std::nullopt;
+}
+
+// Refuses fields the brush does not take: a misspelt optional field would
+// otherwise be dropped without a word.
+void refuse_unknown_fields(const nlohmann::json& edit, const BrushKind& kind, EditFields& f) {
+  std::string known = "op, brush, material";
+  for (const std::string& name : kind.fields) known += ", " + name;
+  for (const auto& [name, value] : edit.items()) {
+    bool common = name == "op" || name == "brush" || name == "material";
+    if (!common && std::find(kind.fields.begin(), kind.fields.end(), name) == kind.fields.end()) {
+      f.fail(name, "is not known for brush '" + std::string(kind.name) + "' (fields: " + known + ")");
+    }
+  }
+}
+
+Result<ScriptEdit> read_edit(const nlohmann::json& edit, size_t index, MeshFiles& files) {
+  if (!edit.is_object()) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "edit " + std::to_string(index) + ": must be an object, not " + edit.type_name());
+  }
+  EditFields f(edit, index);
+  std::string op_name = f.text("op"), brush_name = f.text("brush");
+  std::optional<EditOp> op = find_edit_op(op_name);
+  const BrushKind* kind = find_brush_kind(brush_name);
+  if (!op) f.fail("op", "is '" + op_name + "', not an op (add, subtract, intersect, paint)");
+  if (!kind) f.fail("brush", "is '" + brush_name + "', not a brush (sphere, box, capsule, cylinder, noise, mesh)");
+  if (!f.error().ok()) return f.error();
+  refuse_unknown_fields(edit, *kind, f);
+  auto material = uint16_t(f.integer_or("material", 0, 65535));
+  Brush brush = kind->read(f, material, files);
+  if (!f.error().ok()) return f.error();
+  Status s = check_brush(brush);  // the library's own limits (radius > 0, ...), before any edit runs
+  if (!s.ok()) return Status(s.code(), "edit " + std::to_string(index) + ": " + s.message());
+  return ScriptEdit{brush_name, WorldEditor::Edit{std::move(brush), *op}};
+}
+
+Result<nlohmann::json> parse_json_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open");
+  std::ostringstream text;
+  text << in.rdbuf();
+  try {
+    return nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::exception& e) {  // syntax errors, and numbers too large for a double
+    return Status(ErrorCode::kParseError, path + ": malformed JSON: " + e.what());
+  }
+}
+
+Status check_top_level(const nlohmann::json& doc) {
+  if (!doc.is_object()) return {ErrorCode::kInvalidArgument, "the script must be an object {\"edits\": [...]}"};
+  for (const auto& [name, value] : doc.items()) {
+    if (name != "edits") return {ErrorCode::kInvalidArgument, "unknown top-level field '" + name + "' (only \"edits\")"};
+  }
+  if (!doc.contains("edits")) return {ErrorCode::kInvalidArgument, "field 'edits' is missing"};
+  if (!doc.at("edits").is_array()) return {ErrorCode::kInvalidArgument, "field 'edits' must be an array"};
+  return {};
+}
+
+}  // namespace
+
+Result<std::vector<ScriptEdit>> read_edit_script(const std::string& path) {
+  Result<nlohmann::json> doc = parse_json_file(path);
+  if (!doc.ok()) return doc.status();
+  Status s = check_top_level(doc.value());
+  if (!s.ok()) return Status(s.code(), path + ": " + s.message());
+  MeshFiles files(std::filesystem::path(path).parent_path());
+  const nlohmann::json& list = doc.value().at("edits");
+  std::vector<ScriptEdit> edits;
+  for (size_t i = 0; i < list.size(); ++i) {
+    Result<ScriptEdit> e = read_edit(list[i], i, files);
+    if (!e.ok()) return Status(e.status().code(), path + ": " + e.status().message());
+    edits.push_back(std::move(e).value());
+  }
+  return edits;
+}
+
+}  // namespace ldc::tool

@@ -1,0 +1,111 @@
+#include "mesh_output.h"
+
+#include <cstdio>
+
+#include "contour/export.h"
+
+namespace ldc::tool {
+namespace {
+
+Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats* stats) {
+  if (a.method == "mc") return marching_cubes(w, ctx);
+  ContourConfig c = a.config;
+  if (a.method == "iterative") c.placement = Placement::kIterative;
+  else if (a.method == "qef") c.placement = Placement::kQef;
+  else if (a.method == "masspoint") c.placement = Placement::kMassPoint;
+  else return Status(ErrorCode::kInvalidArgument, "--method '" + a.method + "': use iterative, qef, masspoint or mc");
+  return contour_world(w, c, ctx, stats);
+}
+
+ExportOptions export_options(const World& w) {
+  ExportOptions o;
+  for (int id = 0; id < 256; ++id) {
+    std::string name = w.metadata_value("material." + std::to_string(id));
+    if (name.empty()) break;
+    o.material_names.push_back(name);
+  }
+  return o;
+}
+
+nlohmann::json quality_json(const MeshQuality& q, const ContourStats& s) {
+  return {{"triangles", q.triangles},
+          {"vertices", q.vertices},
+          {"closed", q.closed()},
+          {"boundary_edges", q.boundary_edges},
+          {"nonmanifold_edges", q.nonmanifold_edges},
+          {"nonmanifold_vertices", q.nonmanifold_vertices},
+          {"unpaired_edges", q.unpaired_edges},
+          {"degenerate_triangles", q.degenerate_triangles},
+          {"min_angle_deg", q.min_angle_deg},
+          {"min_angle_histogram_10deg", q.min_angle_histogram},
+          {"area", q.area},
+          {"volume", q.volume},
+          {"multi_crossing_edges", s.multi_crossing_edges},
+          {"thin_edges", s.thin_edges},
+          {"clamped_vertices", s.clamped_vertices},
+          {"relaxed_vertices", s.relaxed_vertices},
+          {"qef_rank", s.qef_rank},
+          {"chunks_meshed", s.chunks_meshed}};
+}
+
+void print_report(const nlohmann::json& j) {
+  const auto& q = j["quality"];
+  std::printf("%s: %zu triangles, %zu vertices, %s\n", j["output"].get<std::string>().c_str(),
+              q["triangles"].get<size_t>(), q["vertices"].get<size_t>(),
+              q["closed"].get<bool>() ? "closed" : "NOT closed");
+  std::printf("  boundary edges %zu, non-manifold edges %zu / vertices %zu, degenerate triangles %zu\n",
+              q["boundary_edges"].get<size_t>(), q["nonmanifold_edges"].get<size_t>(),
+              q["nonmanifold_vertices"].get<size_t>(), q["degenerate_triangles"].get<size_t>());
+  std::printf("  min angle %.1f deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
+  for (const auto& b : q["min_angle_histogram_10deg"]) std::printf(" %zu", b.get<size_t>());
+  std::printf("\n  area %.6g, volume %.6g\n", q["area"].get<double>(), q["volume"].get<double>());
+  print_seconds(j["seconds"]);
+}
+
+}  // namespace
+
+void add_mesh_output_options(CLI::App* cmd, MeshOutputArgs& a) {
+  cmd->add_option("-o,--output", a.output, "Output mesh (.obj .ply .stl .glb .drc)")->required();
+  cmd->add_option("--method", a.method, "iterative | qef | masspoint | mc")->capture_default_str();
+  cmd->add_option("--iterations", a.config.iterations, "Iterative placement: steps")->capture_default_str();
+  cmd->add_option("--relax", a.config.relax_iterations, "Material-border relaxation steps (0 = off)")->capture_default_str();
+  cmd->add_option("--slack", a.config.cell_slack, "How far vertices may leave their cell (fraction of h)")->capture_default_str();
+}
+
+void add_grid_options(CLI::App* cmd, GridConfig& grid, const std::string& cells_of) {
+  cmd->add_option("--cells", grid.cells, "Cells along the longest axis of " + cells_of)->capture_default_str();
+  cmd->add_option("--cell-size", grid.cell_size, "Cell size h (overrides --cells)");
+  cmd->add_option("--chunk,--chunk-size", grid.chunk_size, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
+}
+
+Status check_mesh_output(const MeshOutputArgs& args) {
+  Result<MeshFormat> format = mesh_format_from_path(args.output);
+  return format.ok() ? Status{} : format.status();
+}
+
+int contour_and_report(const std::string& command, const World& w, const MeshOutputArgs& a, ProgressBar& bar,
+                       nlohmann::json report, const CommonOptions& common, const ExtraReportLines& extra_lines) {
+  ScopedTimer t(nullptr, "");
+  ContourStats stats;
+  Result<ContourMesh> mesh = run_method(w, a, bar.context(), &stats);
+  report["seconds"]["contour"] = t.seconds();
+  if (!mesh.ok()) return fail(command, mesh.status());
+  ScopedTimer e(nullptr, "");
+  Status s = save_contour_mesh(mesh.value(), a.output, export_options(w));
+  report["seconds"]["export"] = e.seconds();
+  bar.finish();
+  if (!s.ok()) return fail(command, s);
+  report["ok"] = true;
+  report["output"] = a.output;
+  report["method"] = a.method;
+  report["quality"] = quality_json(mesh_quality(mesh.value()), stats);
+  if (common.json) {
+    std::printf("%s\n", report.dump(2).c_str());
+    return 0;
+  }
+  print_report(report);
+  if (extra_lines) extra_lines(report);
+  return 0;
+}
+
+}  // namespace ldc::tool
