@@ -11,6 +11,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "contour/detail/mesh_patch.h"
 #include "contour/detail/region_mesher.h"
 #include "ldc/detail/ray_math.h"
 
@@ -114,6 +115,32 @@ Result<std::vector<ChunkMesh>> mesh_chunks(const World& w, const std::vector<glm
   return kept;
 }
 
+// The boxes to re-mesh for a dirty list: each dirty node box grown to the
+// cells and edges it can affect, overlapping boxes merged (an edit's boxes
+// come one per chunk and meet).
+std::vector<std::pair<glm::ivec3, glm::ivec3>> patch_boxes(const std::vector<DirtyChunk>& dirty, int relax) {
+  std::vector<std::pair<glm::ivec3, glm::ivec3>> boxes;
+  for (const DirtyChunk& d : dirty) {
+    glm::ivec3 lo, hi;
+    detail::patch_box(d.node_lo, d.node_hi, relax, &lo, &hi);
+    boxes.emplace_back(lo, hi);
+  }
+  auto overlap = [](const auto& a, const auto& b) {
+    return glm::all(glm::lessThan(a.first, b.second)) && glm::all(glm::lessThan(b.first, a.second));
+  };
+  for (bool merged = true; merged;) {
+    merged = false;
+    for (size_t i = 0; i < boxes.size() && !merged; ++i)
+      for (size_t j = i + 1; j < boxes.size() && !merged; ++j) {
+        if (!overlap(boxes[i], boxes[j])) continue;
+        boxes[i] = {glm::min(boxes[i].first, boxes[j].first), glm::max(boxes[i].second, boxes[j].second)};
+        boxes.erase(boxes.begin() + long(j));
+        merged = true;
+      }
+  }
+  return boxes;
+}
+
 }  // namespace
 
 Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk, const ContourConfig& config,
@@ -147,11 +174,11 @@ Status ChunkedMesh::build(const World& world, Context* ctx) {
 }
 
 Result<size_t> ChunkedMesh::update(const World& world, const std::vector<glm::ivec3>& changed, Context* ctx) {
-  // A chunk's mesh reads its region: the chunk and a margin into all 26 neighbours.
+  // Anything in the chunk's rays may have changed: its nodes and the edges up to the next chunk's first node.
   const int c = world.chunk_size();
   std::vector<DirtyChunk> whole;
   whole.reserve(changed.size());
-  for (const glm::ivec3& ch : changed) whole.push_back({ch, 0, ch * c, ch * c + c});
+  for (const glm::ivec3& ch : changed) whole.push_back({ch, 0, ch * c, ch * c + c + 1});
   return update(world, whole, ctx);
 }
 
@@ -159,34 +186,54 @@ Result<size_t> ChunkedMesh::update(const World& world, const std::vector<DirtyCh
   if (world.chunk_size() != chunk_size_) {
     return Status(ErrorCode::kInvalidArgument, "contour: update with a world of another chunk size");
   }
-  // Chunk k reads nodes [k*C - M, k*C + C + M): the cells one below its own for
-  // quads, and relax_iterations more on every side where materials meet.
-  const int c = chunk_size_, margin = config_.relax_iterations + 1;
-  auto less = [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); };
-  std::set<glm::ivec3, decltype(less)> todo(less);
-  for (const DirtyChunk& d : dirty) {
-    glm::ivec3 lo, hi;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = detail::floor_div(d.node_lo[a] - margin, c);
-      hi[a] = detail::floor_div(d.node_hi[a] + margin + c - 1, c);
-    }
-    for (int z = lo.z; z < hi.z; ++z)
-      for (int y = lo.y; y < hi.y; ++y)
-        for (int x = lo.x; x < hi.x; ++x) todo.insert({x, y, z});
-  }
-  std::vector<glm::ivec3> list(todo.begin(), todo.end());
+  ScopedTimer timer(ctx, "contour update");
   ContourStats stats;
-  Result<std::vector<ChunkMesh>> r = mesh_chunks(world, list, config_, ctx, stats);
-  if (!r.ok()) return r.status();
-  std::vector<ChunkMesh> merged;
-  for (ChunkMesh& m : chunks_) {
-    if (!todo.count(m.chunk)) merged.push_back(std::move(m));
+  size_t spliced = 0;
+  for (const auto& [lo, hi] : patch_boxes(dirty, config_.relax_iterations)) {
+    if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "contour: cancelled");
+    detail::MeshPatch patch = detail::mesh_patch(world, config_, lo, hi, stats);
+    spliced += splice(patch);
   }
-  for (ChunkMesh& m : r.value()) merged.push_back(std::move(m));
+  stats.seconds = timer.seconds();
+  add_stats(stats_, stats);
+  return spliced;
+}
+
+// Splices a patch into every chunk mesh whose cells or edges it overlaps, in parallel.
+size_t ChunkedMesh::splice(const detail::MeshPatch& patch) {
+  const int c = chunk_size_;
+  glm::ivec3 first, last;
+  for (int a = 0; a < 3; ++a) {
+    first[a] = detail::floor_div(patch.lo[a], c);
+    last[a] = detail::floor_div(patch.hi[a] - 1, c);
+  }
+  std::vector<glm::ivec3> targets;
+  for (int z = first.z; z <= last.z; ++z)
+    for (int y = first.y; y <= last.y; ++y)
+      for (int x = first.x; x <= last.x; ++x) targets.emplace_back(x, y, z);
+  auto find = [&](const glm::ivec3& ch) -> const ChunkMesh* {
+    auto it = std::lower_bound(chunks_.begin(), chunks_.end(), ch,
+                               [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_less(m.chunk, k); });
+    return it != chunks_.end() && it->chunk == ch ? &*it : nullptr;
+  };
+  std::vector<ChunkMesh> spliced(targets.size());
+  tbb::parallel_for(size_t{0}, targets.size(), [&](size_t i) {
+    const ChunkMesh* old = find(targets[i]);
+    spliced[i] = detail::splice_patch(old ? *old : ChunkMesh{}, patch, targets[i], c);
+  });
+  std::vector<ChunkMesh> merged;
+  merged.reserve(chunks_.size() + targets.size());
+  auto less = [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); };
+  std::set<glm::ivec3, decltype(less)> replaced(targets.begin(), targets.end(), less);
+  for (ChunkMesh& m : chunks_) {
+    if (!replaced.count(m.chunk)) merged.push_back(std::move(m));
+  }
+  for (ChunkMesh& m : spliced) {
+    if (!m.mesh.positions.empty()) merged.push_back(std::move(m));
+  }
   std::sort(merged.begin(), merged.end(), [](const ChunkMesh& a, const ChunkMesh& b) { return chunk_less(a.chunk, b.chunk); });
   chunks_ = std::move(merged);
-  add_stats(stats_, stats);
-  return list.size();
+  return targets.size();
 }
 
 // Chunk by chunk in parallel: each chunk's own vertices and triangles go to

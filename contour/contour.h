@@ -38,6 +38,9 @@
 #include "ldc/world.h"
 
 namespace ldc {
+namespace detail {
+struct MeshPatch;
+}
 
 // Where a cell's vertex goes, given the Hermite planes of its crossings.
 enum class Placement {
@@ -141,16 +144,15 @@ class ChunkedMesh {
   explicit ChunkedMesh(ContourConfig config = {}) : config_(config) {}
   // Meshes every chunk of the world (in parallel).
   Status build(const World& world, Context* ctx = nullptr);
-  // Re-meshes the given chunks and those whose meshes read them (the 26
-  // chunks around each: a chunk's mesh reads a margin of cells into all its
-  // neighbours); leaves every other chunk mesh as it was. Returns how many
-  // chunks were re-meshed.
+  // Re-meshes the given chunks and the margin of cells around them that
+  // their change can reach (see the next overload); leaves every other chunk
+  // mesh as it was.
   Result<size_t> update(const World& world, const std::vector<glm::ivec3>& changed_chunks,
                         Context* ctx = nullptr);
-  // Re-meshes only the chunks whose meshes read a node in one of the dirty
-  // boxes (a chunk reads its own nodes and relax_iterations + 1 more on every
-  // side): an edit inside a chunk re-meshes that chunk alone. Returns how
-  // many chunks were re-meshed.
+  // Re-meshes only the cells whose vertices the dirty boxes can move (each
+  // box grown by relax_iterations + 1 cells) and the quads around them, and
+  // splices them into the chunk meshes they fall in; the result equals a
+  // fresh build. Returns how many chunk meshes were spliced.
   Result<size_t> update(const World& world, const std::vector<DirtyChunk>& dirty, Context* ctx = nullptr);
   const std::vector<ChunkMesh>& chunks() const { return chunks_; }
   // One welded mesh: every vertex once, chunk by chunk, in a fixed order.
@@ -158,6 +160,8 @@ class ChunkedMesh {
   const ContourStats& stats() const { return stats_; }
 
  private:
+  size_t splice(const detail::MeshPatch& patch);
+
   ContourConfig config_;
   int chunk_size_ = 32;
   std::vector<ChunkMesh> chunks_;  // non-empty chunk meshes, sorted by chunk (z, y, x)

@@ -14,6 +14,10 @@ glm::ivec3 unit(int axis) {
   return e;
 }
 
+bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
+  return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
+}
+
 }  // namespace
 
 void optimize_triangle_order(ContourMesh& m);
@@ -122,7 +126,9 @@ CellPlanes RegionMesher::planes_of(const glm::ivec3& cell) const {
   return planes;
 }
 
-void RegionMesher::place_vertices(ContourStats& stats) {
+// Every vertex the box's quads use is placed; in the relaxation margin
+// beyond them only border vertices are, as relaxation reads no others.
+void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi, ContourStats& stats) {
   std::vector<uint8_t> marked = cells_with_vertex();
   cell_vertex_.assign(marked.size(), -1);
   verts_.clear();
@@ -134,6 +140,7 @@ void RegionMesher::place_vertices(ContourStats& stats) {
         if (!marked[i]) continue;
         glm::ivec3 cell(x, y, z);
         CellPlanes planes = planes_of(cell);
+        if (!planes.mixed_materials() && !in_box(cell, used_lo, used_hi)) continue;
         CellVertex v;
         v.cell = cell;
         v.qef = Qef::of(planes);
@@ -196,18 +203,10 @@ glm::dvec3 RegionMesher::relaxed_position(const glm::ivec3& cell) const {
   return clamp_to_cell(p, glm::dvec3(0.0), config_.cell_slack, nullptr);
 }
 
-namespace {
-
-bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
-  return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
-}
-
-}  // namespace
-
 // Triangles of the quads of the box's own edges, in the order the region
 // found them (deterministic).
 void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out,
-                        ContourStats& stats) {
+                        ContourStats& stats, bool order_triangles) {
   std::vector<int32_t> out_index(verts_.size(), -1);
   ContourMesh& m = out.mesh;
   auto add_vertex = [&](const glm::ivec3& cell) {
@@ -238,7 +237,7 @@ void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
     ++stats.quads;
   }
   finish_vertices(out, stats);
-  optimize_triangle_order(m);
+  if (order_triangles) optimize_triangle_order(m);
 }
 
 // Reorders the chunk's triangles for the post-transform vertex cache
@@ -303,7 +302,7 @@ bool RegionMesher::single_material() const {
 }
 
 void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out,
-                        ContourStats& stats) {
+                        ContourStats& stats, bool order_triangles) {
   out.mesh = {};
   out.vertex_cell.clear();
   out.own_vertices = 0;
@@ -316,9 +315,9 @@ void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
   stats.multi_crossing_edges += region_.multi_crossing_edges();
   stats.thin_edges += region_.thin_edges();
   if (region_.uniform()) return;
-  place_vertices(stats);
+  place_vertices(own_lo - 1, own_hi, stats);
   relax();
-  emit(own_lo, own_hi, out, stats);
+  emit(own_lo, own_hi, out, stats, order_triangles);
 }
 
 }  // namespace ldc::detail

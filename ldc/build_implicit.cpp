@@ -59,11 +59,21 @@ double find_root(const ImplicitSolid& solid, const glm::dvec3& a, const glm::dve
   return t;
 }
 
-// Chunk-local sampling of value() at the (C+1)^3 nodes a chunk's rays need.
+// Chunk-local samples of value() at the nodes a chunk's rays need that lie
+// in the solid's bounds: the box [lo, hi) of local nodes (within 0 .. C).
+// Nodes outside the box are outside and never evaluated, so a small solid
+// (a brush) costs its own size, not its chunks'.
 struct NodeSamples {
-  int n = 0;  // C + 1
+  glm::ivec3 lo{0}, hi{0};
   std::vector<double> values;
-  double at(int x, int y, int z) const { return values[(size_t(z) * n + y) * n + x]; }
+  bool contains(const glm::ivec3& n) const {
+    return glm::all(glm::greaterThanEqual(n, lo)) && glm::all(glm::lessThan(n, hi));
+  }
+  double at(const glm::ivec3& n) const {
+    if (!contains(n)) return 1.0;
+    glm::ivec3 r = n - lo, d = hi - lo;
+    return values[(size_t(r.z) * size_t(d.y) + size_t(r.y)) * size_t(d.x) + size_t(r.x)];
+  }
 };
 
 // Samples the chunk; returns -1 if some nodes are inside and some outside,
@@ -72,13 +82,21 @@ struct NodeSamples {
 // world's box faces are outside even for a solid that breaks its contract.
 int sample_chunk(const ImplicitSolid& solid, const WorldBox& bounds, const Lattice& lat,
                  const glm::ivec3& node0, int c, NodeSamples& s) {
-  s.n = c + 1;
-  s.values.resize(size_t(s.n) * s.n * s.n);
-  size_t inside = 0;
-  size_t i = 0;
-  for (int z = 0; z <= c; ++z)
-    for (int y = 0; y <= c; ++y)
-      for (int x = 0; x <= c; ++x, ++i) {
+  // The nodes that can lie in the bounds, with a node of slack for rounding;
+  // each is still tested exactly below.
+  glm::dvec3 blo = lat.to_lattice(bounds.min), bhi = lat.to_lattice(bounds.max);
+  for (int a = 0; a < 3; ++a) {
+    double lo = std::clamp(std::floor(blo[a]) - 1.0 - node0[a], 0.0, double(c + 1));
+    double hi = std::clamp(std::ceil(bhi[a]) + 2.0 - node0[a], 0.0, double(c + 1));
+    s.lo[a] = int(lo);
+    s.hi[a] = std::max(int(hi), s.lo[a]);
+  }
+  const glm::ivec3 d = s.hi - s.lo;
+  s.values.resize(size_t(d.x) * size_t(d.y) * size_t(d.z));
+  size_t inside = 0, i = 0;
+  for (int z = s.lo.z; z < s.hi.z; ++z)
+    for (int y = s.lo.y; y < s.hi.y; ++y)
+      for (int x = s.lo.x; x < s.hi.x; ++x, ++i) {
         glm::dvec3 p = lat.node_position(node0 + glm::ivec3(x, y, z));
         bool in_bounds = glm::all(glm::greaterThanEqual(p, bounds.min)) &&
                          glm::all(glm::lessThanEqual(p, bounds.max));
@@ -87,7 +105,7 @@ int sample_chunk(const ImplicitSolid& solid, const WorldBox& bounds, const Latti
         inside += v < 0.0;
       }
   if (inside == 0) return 0;
-  if (inside == s.values.size()) return 1;
+  if (inside == size_t(c + 1) * size_t(c + 1) * size_t(c + 1)) return 1;
   return -1;
 }
 
@@ -123,17 +141,24 @@ RayFamily implicit_family(const ImplicitSolid& solid, const Lattice& lat, const 
                           int axis, int c, const NodeSamples& s, ImplicitCounts& counts) {
   RayFamilyWriter wr(c);
   const int u = axis_u(axis), v = axis_v(axis);
+  // Only edges with an end in the sampled box can change sign.
+  const int first_edge = std::max(0, s.lo[axis] - 1), end_edge = std::min(c, s.hi[axis]);
   for (int rv = 0; rv < c; ++rv) {
     for (int ru = 0; ru < c; ++ru) {
+      if (ru < s.lo[u] || ru >= s.hi[u] || rv < s.lo[v] || rv >= s.hi[v]) {
+        wr.begin_ray(false);  // the whole ray lies outside the bounds
+        continue;
+      }
       glm::ivec3 local(0);
       local[u] = ru;
       local[v] = rv;
-      double prev = s.at(local.x, local.y, local.z);
-      wr.begin_ray(prev < 0.0);
-      for (int n = 0; n < c; ++n) {
+      wr.begin_ray(s.at(local) < 0.0);
+      local[axis] = first_edge;
+      double prev = s.at(local);
+      for (int n = first_edge; n < end_edge; ++n) {
         glm::ivec3 nl = local;
         nl[axis] = n + 1;
-        double next = s.at(nl.x, nl.y, nl.z);
+        double next = s.at(nl);
         if ((prev < 0.0) != (next < 0.0)) {
           glm::ivec3 node = node0 + local;
           node[axis] = node0[axis] + n;

@@ -17,8 +17,10 @@ class RegionMesher {
 
   // Cells [own_lo, own_hi) (by their lowest corner) and the edges whose lower
   // node lies there. Vertices of cells outside the box that these quads use
-  // are appended after the box's own vertices.
-  void mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats);
+  // are appended after the box's own vertices. With order_triangles, the
+  // triangles are reordered for the vertex cache.
+  void mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats,
+            bool order_triangles = true);
 
   // Cells of margin needed below a box (quads read the cells one below) when
   // relaxation runs: it reaches one cell further per iteration, on every side.
@@ -42,7 +44,7 @@ class RegionMesher {
   bool single_material() const;
   std::vector<uint8_t> cells_with_vertex() const;
   CellPlanes planes_of(const glm::ivec3& cell) const;
-  void place_vertices(ContourStats& stats);
+  void place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi, ContourStats& stats);
   void relax();
   glm::dvec3 relaxed_position(const glm::ivec3& cell) const;
   bool edge_quad(int axis, const glm::ivec3& node, Quad* quad) const;
@@ -52,7 +54,8 @@ class RegionMesher {
   const CellVertex* vertex(const glm::ivec3& cell) const;
   size_t cell_index(const glm::ivec3& cell) const;
   bool in_cell_box(const glm::ivec3& cell) const;
-  void emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats);
+  void emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats,
+            bool order_triangles);
   void finish_vertices(ChunkMesh& out, ContourStats& stats) const;
 
   const World& world_;

@@ -1,0 +1,190 @@
+// Incremental re-meshing by patches; see detail/mesh_patch.h for why it is exact.
+#include "contour/detail/mesh_patch.h"
+
+#include <algorithm>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "contour/detail/region_mesher.h"
+
+namespace ldc::detail {
+
+void optimize_triangle_order(ContourMesh& m);
+
+namespace {
+
+bool cell_less(const glm::ivec3& a, const glm::ivec3& b) {
+  if (a.z != b.z) return a.z < b.z;
+  if (a.y != b.y) return a.y < b.y;
+  return a.x < b.x;
+}
+
+bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
+  return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
+}
+
+// The edge a quad triangle came from: its three cells share the coordinate
+// along the edge's axis, and the edge's node is their largest corner.
+glm::ivec3 edge_node(const glm::ivec3 (&cell)[3]) {
+  return glm::max(glm::max(cell[0], cell[1]), cell[2]);
+}
+
+// Cells around the edges a chunk owns lie in [own_lo - 1, own_hi): a dense
+// index over that box maps a cell to a vertex.
+class CellIndex {
+ public:
+  CellIndex(const glm::ivec3& lo, int size) : lo_(lo), n_(size), index_(size_t(size) * size * size, -1) {}
+  int32_t& at(const glm::ivec3& cell) {
+    glm::ivec3 r = cell - lo_;
+    return index_[(size_t(r.z) * n_ + size_t(r.y)) * n_ + size_t(r.x)];
+  }
+  bool contains(const glm::ivec3& cell) const { return in_box(cell, lo_, lo_ + n_); }
+
+ private:
+  glm::ivec3 lo_;
+  int n_;
+  std::vector<int32_t> index_;
+};
+
+// Where a vertex of the spliced chunk comes from.
+struct VertexSource {
+  glm::ivec3 cell;
+  bool from_patch;
+  size_t index;  // into the patch's arrays or the old mesh's
+};
+
+}  // namespace
+
+void patch_box(const glm::ivec3& node_lo, const glm::ivec3& node_hi, int relax_iterations, glm::ivec3* lo,
+               glm::ivec3* hi) {
+  *lo = node_lo - 1 - relax_iterations;
+  *hi = node_hi + relax_iterations + 1;
+}
+
+MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm::ivec3& lo, const glm::ivec3& hi,
+                     ContourStats& stats) {
+  // Slabs along z, one per thread (each re-reads a margin, so no more than that).
+  const int depth = hi.z - lo.z;
+  const int slabs = std::max(1, std::min(tbb::this_task_arena::max_concurrency(), depth / 8));
+  std::vector<ChunkMesh> pieces(static_cast<size_t>(slabs));
+  std::vector<ContourStats> piece_stats(static_cast<size_t>(slabs));
+  tbb::enumerable_thread_specific<RegionMesher> meshers(RegionMesher(world, config));
+  tbb::parallel_for(0, slabs, [&](int s) {
+    glm::ivec3 a = lo, b = hi;
+    a.z = lo.z + depth * s / slabs;
+    b.z = lo.z + depth * (s + 1) / slabs;
+    meshers.local().mesh(a, b, pieces[size_t(s)], piece_stats[size_t(s)], /*order_triangles=*/false);
+  });
+  MeshPatch p;
+  p.lo = lo;
+  p.hi = hi;
+  for (size_t s = 0; s < pieces.size(); ++s) {  // slabs in z order keep the cells sorted
+    const ChunkMesh& m = pieces[s];
+    for (size_t v = 0; v < m.own_vertices; ++v) {
+      p.cells.push_back(m.vertex_cell[v]);
+      p.positions.push_back(m.mesh.positions[v]);
+      p.normals.push_back(m.mesh.normals[v]);
+      p.materials.push_back(m.mesh.vertex_material[v]);
+    }
+    for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+      const glm::uvec3& tri = m.mesh.triangles[t];
+      p.triangles.push_back({{m.vertex_cell[tri.x], m.vertex_cell[tri.y], m.vertex_cell[tri.z]},
+                             m.mesh.triangle_material[t]});
+    }
+    ContourStats& st = piece_stats[s];
+    stats.cells += st.cells;
+    stats.quads += st.quads;
+    stats.multi_crossing_edges += st.multi_crossing_edges;
+    stats.thin_edges += st.thin_edges;
+    stats.clamped_vertices += st.clamped_vertices;
+    stats.relaxed_vertices += st.relaxed_vertices;
+    for (int i = 0; i < 4; ++i) stats.qef_rank[i] += st.qef_rank[i];
+  }
+  return p;
+}
+
+ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::ivec3& chunk, int chunk_size) {
+  const glm::ivec3 own_lo = chunk * chunk_size, own_hi = own_lo + chunk_size;
+  // Triangles: the old ones on edges outside the patch, the patch's on edges this chunk owns.
+  std::vector<MeshPatch::Triangle> tris;
+  tris.reserve(old.mesh.triangles.size());
+  for (size_t t = 0; t < old.mesh.triangles.size(); ++t) {
+    const glm::uvec3& i = old.mesh.triangles[t];
+    MeshPatch::Triangle tri{{old.vertex_cell[i.x], old.vertex_cell[i.y], old.vertex_cell[i.z]},
+                            old.mesh.triangle_material[t]};
+    if (!in_box(edge_node(tri.cell), patch.lo, patch.hi)) tris.push_back(tri);
+  }
+  for (const MeshPatch::Triangle& tri : patch.triangles) {
+    if (in_box(edge_node(tri.cell), own_lo, own_hi)) tris.push_back(tri);
+  }
+  // Own vertices, sorted: the old ones outside the patch merged with the patch's in this chunk.
+  std::vector<VertexSource> sources;
+  auto patch_begin = std::lower_bound(patch.cells.begin(), patch.cells.end(), own_lo, cell_less);
+  size_t p = size_t(patch_begin - patch.cells.begin());
+  auto next_patch_own = [&]() -> bool {
+    while (p < patch.cells.size() && !in_box(patch.cells[p], own_lo, own_hi)) {
+      if (patch.cells[p].z >= own_hi.z) p = patch.cells.size();
+      else ++p;
+    }
+    return p < patch.cells.size();
+  };
+  size_t o = 0;
+  auto next_old_own = [&]() -> bool {
+    while (o < old.own_vertices && in_box(old.vertex_cell[o], patch.lo, patch.hi)) ++o;
+    return o < old.own_vertices;
+  };
+  while (true) {
+    bool has_p = next_patch_own(), has_o = next_old_own();
+    if (!has_p && !has_o) break;
+    if (has_p && (!has_o || cell_less(patch.cells[p], old.vertex_cell[o]))) {
+      sources.push_back({patch.cells[p], true, p});
+      ++p;
+    } else {
+      sources.push_back({old.vertex_cell[o], false, o});
+      ++o;
+    }
+  }
+  const size_t own = sources.size();
+  // Copies of the neighbours' vertices the triangles use, in first-use order.
+  CellIndex index(own_lo - 1, chunk_size + 1);
+  for (size_t v = 0; v < own; ++v) index.at(sources[v].cell) = int32_t(v);
+  CellIndex old_index(own_lo - 1, chunk_size + 1);
+  for (size_t v = 0; v < old.vertex_cell.size(); ++v) {
+    if (old_index.contains(old.vertex_cell[v])) old_index.at(old.vertex_cell[v]) = int32_t(v);
+  }
+  ChunkMesh out;
+  out.chunk = chunk;
+  out.mesh.triangles.reserve(tris.size());
+  out.mesh.triangle_material.reserve(tris.size());
+  for (const MeshPatch::Triangle& tri : tris) {
+    glm::uvec3 ids;
+    for (int j = 0; j < 3; ++j) {
+      int32_t& id = index.at(tri.cell[j]);
+      if (id < 0) {
+        id = int32_t(sources.size());
+        if (in_box(tri.cell[j], patch.lo, patch.hi)) {
+          auto it = std::lower_bound(patch.cells.begin(), patch.cells.end(), tri.cell[j], cell_less);
+          sources.push_back({tri.cell[j], true, size_t(it - patch.cells.begin())});
+        } else {
+          sources.push_back({tri.cell[j], false, size_t(old_index.at(tri.cell[j]))});
+        }
+      }
+      ids[j] = uint32_t(id);
+    }
+    out.mesh.triangles.push_back(ids);
+    out.mesh.triangle_material.push_back(tri.material);
+  }
+  out.own_vertices = own;
+  for (const VertexSource& s : sources) {
+    out.vertex_cell.push_back(s.cell);
+    out.mesh.positions.push_back(s.from_patch ? patch.positions[s.index] : old.mesh.positions[s.index]);
+    out.mesh.normals.push_back(s.from_patch ? patch.normals[s.index] : old.mesh.normals[s.index]);
+    out.mesh.vertex_material.push_back(s.from_patch ? patch.materials[s.index] : old.mesh.vertex_material[s.index]);
+  }
+  optimize_triangle_order(out.mesh);
+  return out;
+}
+
+}  // namespace ldc::detail
