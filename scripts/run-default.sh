@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The main job on the built-in default scene: installs what is needed, builds,
-# generates the procedural landscape, builds its LDC, writes out/default.ldc,
-# prints `ldc info` for it, and contours it into out/default.glb with the
-# mesh quality report.
+# generates the procedural landscape, builds its LDC (out/default.ldc), prints
+# `ldc info` for it, then digs a tunnel through it with a chamber and a pillar
+# (scripts/default-tunnel.json): the landscape is contoured once, each edit
+# re-meshes only what it changed, and the result is written as out/tunnel.ldc
+# and the re-meshed out/tunnel.glb, with per-edit times and the quality report.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -10,4 +12,5 @@ bash scripts/build.sh
 mkdir -p out
 ./build/tools/ldc terrain -o out/default.ldc
 ./build/tools/ldc info out/default.ldc
-./build/tools/ldc contour out/default.ldc -o out/default.glb
+./build/tools/ldc edit out/default.ldc --script scripts/default-tunnel.json -o out/tunnel.ldc \
+  --validate --mesh out/tunnel.glb

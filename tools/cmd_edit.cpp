@@ -4,8 +4,11 @@
 #include <memory>
 
 #include "common.h"
+#include "contour/contour.h"
+#include "contour/export.h"
 #include "edit_script.h"
 #include "ldc/io.h"
+#include "mesh_output.h"
 
 namespace ldc::tool {
 namespace {
@@ -16,6 +19,22 @@ struct EditArgs {
   std::string output;
   bool batch = false;
   bool validate = false;
+  std::string mesh;  // --mesh: contour before the edits, re-mesh after each, write here
+};
+
+// The mesh kept up to date edit by edit, as a game would: built once, then
+// only what each edit dirtied is re-meshed (ChunkedMesh::update).
+struct LiveMesh {
+  std::unique_ptr<ChunkedMesh> meshes;  // null without --mesh
+  Status update(WorldEditor& editor, nlohmann::json& entry) {
+    if (!meshes) return {};
+    ScopedTimer t(nullptr, "");
+    Result<size_t> spliced = meshes->update(editor.world(), editor.take_dirty());
+    if (!spliced.ok()) return spliced.status();
+    entry["remesh_ms"] = 1000.0 * t.seconds();
+    entry["chunk_meshes_updated"] = spliced.value();
+    return {};
+  }
 };
 
 bool has_ldc_extension(const std::string& path) {
@@ -30,7 +49,8 @@ nlohmann::json edit_json(size_t index, const ScriptEdit& e) {
 }
 
 // One apply per edit, so that each edit's chunks and time are its own.
-Status apply_each(WorldEditor& editor, const std::vector<ScriptEdit>& edits, Context* ctx, nlohmann::json& report) {
+Status apply_each(WorldEditor& editor, const std::vector<ScriptEdit>& edits, LiveMesh& live, Context* ctx,
+                  nlohmann::json& report) {
   for (size_t i = 0; i < edits.size(); ++i) {
     ScopedTimer t(nullptr, "");
     Result<EditReceipt> r = editor.apply(edits[i].edit.brush, edits[i].edit.op, ctx);
@@ -41,6 +61,8 @@ Status apply_each(WorldEditor& editor, const std::vector<ScriptEdit>& edits, Con
     nlohmann::json e = edit_json(i, edits[i]);
     e["chunks_changed"] = r.value().changed_chunks.size();
     e["ms"] = 1000.0 * t.seconds();
+    Status s = live.update(editor, e);
+    if (!s.ok()) return s;
     report["edits"].push_back(std::move(e));
   }
   return {};
@@ -48,7 +70,7 @@ Status apply_each(WorldEditor& editor, const std::vector<ScriptEdit>& edits, Con
 
 // One apply_batch: one undo step that visits each chunk once, so chunks and
 // time are known for the batch only. The library's errors name the edit index.
-Status apply_as_batch(WorldEditor& editor, const std::vector<ScriptEdit>& edits, Context* ctx,
+Status apply_as_batch(WorldEditor& editor, const std::vector<ScriptEdit>& edits, LiveMesh& live, Context* ctx,
                       nlohmann::json& report) {
   std::vector<WorldEditor::Edit> batch;
   for (const ScriptEdit& e : edits) batch.push_back(e.edit);
@@ -57,7 +79,7 @@ Status apply_as_batch(WorldEditor& editor, const std::vector<ScriptEdit>& edits,
   if (!r.ok()) return r.status();
   for (size_t i = 0; i < edits.size(); ++i) report["edits"].push_back(edit_json(i, edits[i]));
   report["batch"] = {{"chunks_changed", r.value().changed_chunks.size()}, {"ms", 1000.0 * t.seconds()}};
-  return {};
+  return live.update(editor, report["batch"]);
 }
 
 // --validate: an invalid result is an error, and nothing is written.
@@ -77,11 +99,15 @@ void print_edit_report(const nlohmann::json& report) {
     if (e.contains("chunks_changed")) {
       std::printf(": %zu chunks changed, %.2f ms", e["chunks_changed"].get<size_t>(), e["ms"].get<double>());
     }
+    if (e.contains("remesh_ms")) std::printf(", re-mesh %.2f ms", e["remesh_ms"].get<double>());
     std::printf("\n");
   }
   if (report.contains("batch")) {
-    std::printf("batch of %zu edits: %zu chunks changed, %.2f ms\n", report["edits"].size(),
-                report["batch"]["chunks_changed"].get<size_t>(), report["batch"]["ms"].get<double>());
+    const auto& b = report["batch"];
+    std::printf("batch of %zu edits: %zu chunks changed, %.2f ms", report["edits"].size(),
+                b["chunks_changed"].get<size_t>(), b["ms"].get<double>());
+    if (b.contains("remesh_ms")) std::printf(", re-mesh %.2f ms", b["remesh_ms"].get<double>());
+    std::printf("\n");
   }
   if (report.contains("validation")) std::printf("%s", validation_text(report["validation"]).c_str());
   std::printf("wrote %s (version %llu)\n", report["output"].get<std::string>().c_str(),
@@ -92,6 +118,10 @@ void print_edit_report(const nlohmann::json& report) {
 int run_edit(const EditArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
   if (!has_ldc_extension(a.output)) return fail("edit", "-o " + a.output + ": the output must be a .ldc file");
+  if (!a.mesh.empty()) {
+    Result<MeshFormat> format = mesh_format_from_path(a.mesh);
+    if (!format.ok()) return fail("edit", "--mesh: " + format.status().message());
+  }
   Result<std::vector<ScriptEdit>> edits = read_edit_script(a.script);  // a bad script fails before the world loads
   if (!edits.ok()) return fail("edit", edits.status());
   ProgressBar bar(!common.quiet);
@@ -101,9 +131,17 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   nlohmann::json report = {{"input", a.input}, {"script", a.script}, {"output", a.output},
                            {"edits", nlohmann::json::array()}, {"seconds", {{"load", load.seconds()}}}};
   WorldEditor editor(std::move(w).value());
+  LiveMesh live;
+  if (!a.mesh.empty()) {
+    ScopedTimer t(nullptr, "");
+    live.meshes = std::make_unique<ChunkedMesh>();
+    Status built = live.meshes->build(editor.world(), bar.context());
+    if (!built.ok()) return fail("edit", built);
+    report["seconds"]["contour_before_edits"] = t.seconds();
+  }
   ScopedTimer apply(nullptr, "");
-  Status s = a.batch ? apply_as_batch(editor, edits.value(), bar.context(), report)
-                     : apply_each(editor, edits.value(), bar.context(), report);
+  Status s = a.batch ? apply_as_batch(editor, edits.value(), live, bar.context(), report)
+                     : apply_each(editor, edits.value(), live, bar.context(), report);
   report["seconds"]["edits"] = apply.seconds();
   if (!s.ok()) return fail("edit", s);
   if (a.validate && !(s = validate_result(editor.world(), report)).ok()) {
@@ -115,8 +153,18 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   report["seconds"]["save"] = save.seconds();
   bar.finish();
   if (!s.ok()) return fail("edit", s);
-  report["ok"] = true;
   report["version"] = editor.version();
+  if (live.meshes) {
+    report["world_output"] = a.output;
+    return write_and_report("edit", editor.world(), live.meshes->assemble(), live.meshes->stats(), a.mesh, bar,
+                            std::move(report), common, [](const nlohmann::json& r) {
+                              nlohmann::json edits_only = r;
+                              edits_only["output"] = r["world_output"];
+                              edits_only["seconds"] = nlohmann::json::object();
+                              print_edit_report(edits_only);
+                            });
+  }
+  report["ok"] = true;
   if (common.json) std::printf("%s\n", report.dump(2).c_str());
   else print_edit_report(report);
   return 0;
@@ -133,6 +181,9 @@ void add_edit_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("-o,--output", args->output, "Output .ldc file (written only if every edit succeeds)")->required();
   cmd->add_flag("--batch", args->batch, "Apply all edits in one apply_batch (one undo step; per-batch counts)");
   cmd->add_flag("--validate", args->validate, "Validate the result; exit 2 and write nothing if invalid");
+  cmd->add_option("--mesh", args->mesh,
+                  "Also contour the world before the edits, re-mesh only what each edit dirtied, and write the "
+                  "mesh here (.obj .ply .stl .glb .drc) with its quality report");
   cmd->footer(kEditScriptHelp);
   cmd->callback([args, &common] {
     int code = run_edit(*args, common);

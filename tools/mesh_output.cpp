@@ -90,15 +90,21 @@ int contour_and_report(const std::string& command, const World& w, const MeshOut
   Result<ContourMesh> mesh = run_method(w, a, bar.context(), &stats);
   report["seconds"]["contour"] = t.seconds();
   if (!mesh.ok()) return fail(command, mesh.status());
+  report["method"] = a.method;
+  return write_and_report(command, w, mesh.value(), stats, a.output, bar, std::move(report), common, extra_lines);
+}
+
+int write_and_report(const std::string& command, const World& w, const ContourMesh& mesh, const ContourStats& stats,
+                     const std::string& output, ProgressBar& bar, nlohmann::json report, const CommonOptions& common,
+                     const ExtraReportLines& extra_lines) {
   ScopedTimer e(nullptr, "");
-  Status s = save_contour_mesh(mesh.value(), a.output, export_options(w));
+  Status s = save_contour_mesh(mesh, output, export_options(w));
   report["seconds"]["export"] = e.seconds();
   bar.finish();
   if (!s.ok()) return fail(command, s);
   report["ok"] = true;
-  report["output"] = a.output;
-  report["method"] = a.method;
-  report["quality"] = quality_json(mesh_quality(mesh.value()), stats);
+  report["output"] = output;
+  report["quality"] = quality_json(mesh_quality(mesh), stats);
   if (common.json) {
     std::printf("%s\n", report.dump(2).c_str());
     return 0;

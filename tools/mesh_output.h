@@ -38,4 +38,9 @@ int contour_and_report(const std::string& command, const World& world, const Mes
                        ProgressBar& bar, nlohmann::json report, const CommonOptions& common,
                        const ExtraReportLines& extra_lines = {});
 
+// Writes a mesh already made and prints the report, as contour_and_report.
+int write_and_report(const std::string& command, const World& world, const ContourMesh& mesh,
+                     const ContourStats& stats, const std::string& output, ProgressBar& bar, nlohmann::json report,
+                     const CommonOptions& common, const ExtraReportLines& extra_lines = {});
+
 }  // namespace ldc::tool
