@@ -11,8 +11,6 @@
 
 namespace ldc::detail {
 
-void optimize_triangle_order(ContourMesh& m);
-
 namespace {
 
 bool cell_less(const glm::ivec3& a, const glm::ivec3& b) {
@@ -183,7 +181,9 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
     out.mesh.normals.push_back(s.from_patch ? patch.normals[s.index] : old.mesh.normals[s.index]);
     out.mesh.vertex_material.push_back(s.from_patch ? patch.materials[s.index] : old.mesh.vertex_material[s.index]);
   }
-  optimize_triangle_order(out.mesh);
+  // No vertex-cache re-ordering here: it would cost more than the splice. The
+  // kept triangles keep their optimized order and the patch's follow in cell
+  // order, which is nearly as cache-friendly; a full build re-optimizes.
   return out;
 }
 

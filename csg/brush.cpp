@@ -105,8 +105,8 @@ Status check_brush(const Brush& b) {
       if (!(n.amplitude >= 0.0 && n.amplitude <= 0.9)) {
         return {ErrorCode::kInvalidArgument, "brush: noise amplitude = " + std::to_string(n.amplitude) + " must be in 0 .. 0.9"};
       }
-      if (!(n.frequency > 0.0) || !std::isfinite(n.frequency)) {
-        return {ErrorCode::kInvalidArgument, "brush: noise frequency must be > 0"};
+      if (!(n.frequency > 0.0 && n.frequency <= 64.0)) {
+        return {ErrorCode::kInvalidArgument, "brush: noise frequency = " + std::to_string(n.frequency) + " must be in (0, 64]"};
       }
       if (!finite_matrix(b.transform)) return {ErrorCode::kInvalidArgument, "brush: transform is not finite"};
       return {};

@@ -2,8 +2,13 @@
 // builder (node signs sampled, exact or root-searched crossings), meshes
 // through the watertight mesh builder, all on the world's own lattice so the
 // result's chunks line up with the world's.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <vector>
 
 #include "csg/detail/brush_raster.h"
 
@@ -69,12 +74,85 @@ double fractal_noise(const glm::dvec3& p, uint32_t seed) {
          1.75;
 }
 
+// fractal_noise over the unit sphere, tabulated on a cube map: every brush
+// with the same frequency and seed shares one table, so a dig evaluates a
+// bilinear lookup per sample instead of three octaves of gradient noise (the
+// noise dominated the edit, 10 ms of a 2 m dig). Grid vertices on a face's
+// border are computed from the same cube point as the neighbour face's, and
+// the lookup on a border reads that border only, so the tabulated noise is
+// continuous over the sphere and the brush stays a star-shaped solid.
+class NoiseTable {
+ public:
+  NoiseTable(double frequency, uint32_t seed)
+      : n_(std::clamp(int(std::ceil(32.0 * frequency)), 32, 256)), values_(6 * size_t(n_ + 1) * size_t(n_ + 1)) {
+    for (int face = 0; face < 6; ++face) {
+      for (int j = 0; j <= n_; ++j) {
+        for (int i = 0; i <= n_; ++i) {
+          glm::dvec3 p = cube_point(face, -1.0 + 2.0 * i / n_, -1.0 + 2.0 * j / n_);
+          values_[index(face, i, j)] = float(fractal_noise(glm::normalize(p) * frequency, seed));
+        }
+      }
+    }
+  }
+
+  // The noise in unit direction d.
+  double at(const glm::dvec3& d) const {
+    glm::dvec3 m = glm::abs(d);
+    int axis = m.x >= m.y && m.x >= m.z ? 0 : (m.y >= m.z ? 1 : 2);
+    int face = 2 * axis + (d[axis] < 0.0);
+    double x = (d[(axis + 1) % 3] / m[axis] + 1.0) * 0.5 * n_;
+    double y = (d[(axis + 2) % 3] / m[axis] + 1.0) * 0.5 * n_;
+    int i = std::clamp(int(x), 0, n_ - 1), j = std::clamp(int(y), 0, n_ - 1);
+    double u = std::clamp(x - i, 0.0, 1.0), v = std::clamp(y - j, 0.0, 1.0);
+    double a = values_[index(face, i, j)], b = values_[index(face, i + 1, j)];
+    double c = values_[index(face, i, j + 1)], e = values_[index(face, i + 1, j + 1)];
+    return (1.0 - v) * ((1.0 - u) * a + u * b) + v * ((1.0 - u) * c + u * e);
+  }
+
+ private:
+  // Face 2a (+a) or 2a + 1 (-a); s, t along axes a + 1 and a + 2 (mod 3).
+  static glm::dvec3 cube_point(int face, double s, double t) {
+    int axis = face / 2;
+    glm::dvec3 p;
+    p[axis] = face % 2 ? -1.0 : 1.0;
+    p[(axis + 1) % 3] = s;
+    p[(axis + 2) % 3] = t;
+    return p;
+  }
+  size_t index(int face, int i, int j) const { return (size_t(face) * (n_ + 1) + size_t(j)) * (n_ + 1) + size_t(i); }
+
+  int n_;
+  std::vector<float> values_;
+};
+
+// Tables by (frequency, seed), built on first use and kept (at most
+// kMaxTables; then the cache starts over). Safe from concurrent rasterizers.
+std::shared_ptr<const NoiseTable> noise_table(double frequency, uint32_t seed) {
+  constexpr size_t kMaxTables = 32;
+  static std::mutex mutex;
+  static std::map<std::pair<double, uint32_t>, std::shared_ptr<const NoiseTable>> tables;
+  const auto key = std::make_pair(frequency, seed);
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    auto it = tables.find(key);
+    if (it != tables.end()) return it->second;
+  }
+  auto table = std::make_shared<const NoiseTable>(frequency, seed);  // built outside the lock
+  std::lock_guard<std::mutex> lock(mutex);
+  if (tables.size() >= kMaxTables) tables.clear();
+  return tables.try_emplace(key, table).first->second;
+}
+
 // |x| - R (1 + amplitude * noise(direction)) in the brush's local frame: a
 // star-shaped solid, so every radial line crosses its surface once.
 class NoiseSphereSolid final : public ImplicitSolid {
  public:
   explicit NoiseSphereSolid(const Brush& b)
-      : n_(b.noise), transform_(b.transform), inverse_(glm::inverse(b.transform)), material_(b.material) {}
+      : n_(b.noise),
+        table_(noise_table(b.noise.frequency, b.noise.seed)),
+        transform_(b.transform),
+        inverse_(glm::inverse(b.transform)),
+        material_(b.material) {}
 
   double value(const glm::dvec3& world) const override {
     glm::dvec3 l(inverse_ * glm::dvec4(world, 1.0));
@@ -113,10 +191,11 @@ class NoiseSphereSolid final : public ImplicitSolid {
 
  private:
   double local_radius(const glm::dvec3& direction) const {
-    return n_.radius * (1.0 + n_.amplitude * fractal_noise(direction * n_.frequency, n_.seed));
+    return n_.radius * (1.0 + n_.amplitude * table_->at(direction));
   }
 
   NoiseSphere n_;
+  std::shared_ptr<const NoiseTable> table_;
   glm::dmat4 transform_, inverse_;
   uint16_t material_;
 };

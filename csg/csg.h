@@ -70,10 +70,14 @@ Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, Boolean
 // --- Brushes --------------------------------------------------------------------
 
 // A sphere whose radius is displaced by fractal noise: natural-looking digging.
+// The noise (three octaves of gradient noise over the direction) is tabulated
+// once per (frequency, seed) on a cube map of 32 * frequency texels a face
+// edge (32 .. 256) and shared by every brush that uses it; the brush is that
+// map's bilinear interpolation, continuous over the sphere.
 struct NoiseSphere {
   double radius = 1.0;      // mean radius [Units: m] [Limit: > 0]
   double amplitude = 0.25;  // displacement as a fraction of the radius [Limit: 0 .. 0.9]
-  double frequency = 2.0;   // noise cycles per radius [Limit: > 0]
+  double frequency = 2.0;   // noise cycles per radius [Limit: > 0 .. 64]
   uint32_t seed = 1;
 };
 
