@@ -21,6 +21,17 @@ mkdir -p docs
   echo "contour_stanford-bunny-filled.svg (in docs/)."
   echo
   ./build/bench/bench_contour --plots docs
+  echo
+  echo "## Mesh booleans against CGAL corefinement and OpenVDB (issue 4)"
+  echo
+  echo "Plots of time against error: csg_bunny_sphere.svg, csg_bunny_sphere_raw.svg, csg_fandisk_cylinder.svg,"
+  echo "csg_rocker_sphere.svg, csg_spot_spot.svg (in docs/)."
+  echo
+  ./build/bench/bench_csg --plots docs
+  echo
+  echo "## Game edits on the default landscape (issue 4)"
+  echo
+  ./build/bench/bench_csg_game
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"
