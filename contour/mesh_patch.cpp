@@ -30,20 +30,46 @@ glm::ivec3 edge_node(const glm::ivec3 (&cell)[3]) {
 }
 
 // Cells around the edges a chunk owns lie in [own_lo - 1, own_hi): a dense
-// index over that box maps a cell to a vertex.
+// index over that box maps a cell to a vertex. The slots live in a buffer
+// kept per thread and per slot (two per splice), all -1 between uses: only
+// the slots a splice set are reset, so a splice does not pay for clearing or
+// faulting in (C + 1)^3 slots (that was most of a small edit's splice).
+// splice_patch starts no parallel work, so no thread re-enters it (and its
+// buffers) through TBB's work stealing.
 class CellIndex {
  public:
-  CellIndex(const glm::ivec3& lo, int size) : lo_(lo), n_(size), index_(size_t(size) * size * size, -1) {}
-  int32_t& at(const glm::ivec3& cell) {
-    glm::ivec3 r = cell - lo_;
-    return index_[(size_t(r.z) * n_ + size_t(r.y)) * n_ + size_t(r.x)];
+  CellIndex(const glm::ivec3& lo, int size, int slot) : lo_(lo), n_(size), index_(buffer(slot)) {
+    const size_t cells = size_t(size) * size * size;
+    if (index_.size() < cells) index_.assign(cells, -1);
+  }
+  ~CellIndex() {
+    for (size_t i : touched_) index_[i] = -1;
+  }
+  CellIndex(const CellIndex&) = delete;
+  CellIndex& operator=(const CellIndex&) = delete;
+
+  int32_t get(const glm::ivec3& cell) const { return index_[offset(cell)]; }
+  void set(const glm::ivec3& cell, int32_t value) {
+    size_t i = offset(cell);
+    if (index_[i] < 0) touched_.push_back(i);
+    index_[i] = value;
   }
   bool contains(const glm::ivec3& cell) const { return in_box(cell, lo_, lo_ + n_); }
 
  private:
+  static std::vector<int32_t>& buffer(int slot) {
+    thread_local std::vector<int32_t> buffers[2];
+    return buffers[slot];
+  }
+  size_t offset(const glm::ivec3& cell) const {
+    glm::ivec3 r = cell - lo_;
+    return (size_t(r.z) * n_ + size_t(r.y)) * n_ + size_t(r.x);
+  }
+
   glm::ivec3 lo_;
   int n_;
-  std::vector<int32_t> index_;
+  std::vector<int32_t>& index_;
+  std::vector<size_t> touched_;
 };
 
 // Where a vertex of the spliced chunk comes from.
@@ -106,8 +132,12 @@ MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm:
 ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::ivec3& chunk, int chunk_size) {
   const glm::ivec3 own_lo = chunk * chunk_size, own_hi = own_lo + chunk_size;
   // Triangles: the old ones on edges outside the patch, the patch's on edges this chunk owns.
-  std::vector<MeshPatch::Triangle> tris;
-  tris.reserve(old.mesh.triangles.size());
+  // Scratch kept per thread: fresh large vectors would fault in new pages on
+  // every splice (mmap'ed by malloc), which cost more than filling them.
+  thread_local std::vector<MeshPatch::Triangle> tris;
+  thread_local std::vector<VertexSource> sources;
+  tris.clear();
+  sources.clear();
   for (size_t t = 0; t < old.mesh.triangles.size(); ++t) {
     const glm::uvec3& i = old.mesh.triangles[t];
     MeshPatch::Triangle tri{{old.vertex_cell[i.x], old.vertex_cell[i.y], old.vertex_cell[i.z]},
@@ -118,7 +148,6 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
     if (in_box(edge_node(tri.cell), own_lo, own_hi)) tris.push_back(tri);
   }
   // Own vertices, sorted: the old ones outside the patch merged with the patch's in this chunk.
-  std::vector<VertexSource> sources;
   auto patch_begin = std::lower_bound(patch.cells.begin(), patch.cells.end(), own_lo, cell_less);
   size_t p = size_t(patch_begin - patch.cells.begin());
   auto next_patch_own = [&]() -> bool {
@@ -146,11 +175,11 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   }
   const size_t own = sources.size();
   // Copies of the neighbours' vertices the triangles use, in first-use order.
-  CellIndex index(own_lo - 1, chunk_size + 1);
-  for (size_t v = 0; v < own; ++v) index.at(sources[v].cell) = int32_t(v);
-  CellIndex old_index(own_lo - 1, chunk_size + 1);
+  CellIndex index(own_lo - 1, chunk_size + 1, 0);
+  for (size_t v = 0; v < own; ++v) index.set(sources[v].cell, int32_t(v));
+  CellIndex old_index(own_lo - 1, chunk_size + 1, 1);
   for (size_t v = 0; v < old.vertex_cell.size(); ++v) {
-    if (old_index.contains(old.vertex_cell[v])) old_index.at(old.vertex_cell[v]) = int32_t(v);
+    if (old_index.contains(old.vertex_cell[v])) old_index.set(old.vertex_cell[v], int32_t(v));
   }
   ChunkMesh out;
   out.chunk = chunk;
@@ -159,14 +188,15 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   for (const MeshPatch::Triangle& tri : tris) {
     glm::uvec3 ids;
     for (int j = 0; j < 3; ++j) {
-      int32_t& id = index.at(tri.cell[j]);
+      int32_t id = index.get(tri.cell[j]);
       if (id < 0) {
         id = int32_t(sources.size());
+        index.set(tri.cell[j], id);
         if (in_box(tri.cell[j], patch.lo, patch.hi)) {
           auto it = std::lower_bound(patch.cells.begin(), patch.cells.end(), tri.cell[j], cell_less);
           sources.push_back({tri.cell[j], true, size_t(it - patch.cells.begin())});
         } else {
-          sources.push_back({tri.cell[j], false, size_t(old_index.at(tri.cell[j]))});
+          sources.push_back({tri.cell[j], false, size_t(old_index.get(tri.cell[j]))});
         }
       }
       ids[j] = uint32_t(id);
