@@ -95,7 +95,7 @@ Result<World> boolean(const World& a, const World& b, BooleanOp op, const Boolea
 }
 
 Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid,
-                           const BooleanConfig& config, Context* ctx) {
+                           const BooleanConfig& config, Context* ctx, std::array<BuildReport, 2>* reports) {
   Status s = check_boolean_config(config);
   if (s.ok()) s = check_mesh(a, "first mesh");
   if (s.ok()) s = check_mesh(b, "second mesh");
@@ -113,9 +113,9 @@ Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, Boolean
   shared.cell_size = plan.value().lattice.cell_size;
   shared.use_origin = true;
   shared.origin = plan.value().lattice.origin;
-  Result<World> wa = build_from_mesh(a, shared, ctx);
+  Result<World> wa = build_from_mesh(a, shared, ctx, reports ? &(*reports)[0] : nullptr);
   if (!wa.ok()) return Status(wa.status().code(), "first mesh: " + wa.status().message());
-  Result<World> wb = build_from_mesh(b, shared, ctx);
+  Result<World> wb = build_from_mesh(b, shared, ctx, reports ? &(*reports)[1] : nullptr);
   if (!wb.ok()) return Status(wb.status().code(), "second mesh: " + wb.status().message());
   return boolean(wa.value(), wb.value(), op, config, ctx);
 }

@@ -25,6 +25,7 @@
 // returns an undo handle.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <map>
 #include <memory>
@@ -63,9 +64,11 @@ Result<World> boolean(const World& a, const World& b, BooleanOp op, const Boolea
 // Builds two meshes into one lattice sized for both (`grid` as for
 // build_from_mesh, applied to their joint bounds) and combines them: what
 // `ldc boolean` does. Open, self-intersecting and non-manifold meshes are
-// accepted (their LDCs are repaired, see build_from_mesh).
+// accepted (their LDCs are repaired, see build_from_mesh). `reports`, when
+// given, receives the two builds' reports (repaired rays and all), a's first.
 Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid,
-                           const BooleanConfig& config = {}, Context* ctx = nullptr);
+                           const BooleanConfig& config = {}, Context* ctx = nullptr,
+                           std::array<BuildReport, 2>* reports = nullptr);
 
 // --- Brushes --------------------------------------------------------------------
 

@@ -24,13 +24,15 @@ Result<BooleanOp> parse_boolean_op(const std::string& name) {
   return Status(ErrorCode::kInvalidArgument, "--op '" + name + "': use union, difference or intersection");
 }
 
-// mesh_boolean keeps its two builds' reports to itself, so the repaired-ray
-// count is not available here; whether an input is open (and so was decided
-// by the repair's half-ray votes) is.
-nlohmann::json input_json(const std::string& file, const TriangleMesh& mesh) {
-  MeshTopology t = mesh_topology(mesh);
-  return {{"file", file}, {"triangles", mesh.triangle_count()}, {"closed", t.closed()},
-          {"boundary_edges", t.boundary_edges}};
+// An input as its build saw it: open inputs are decided by the repair's
+// half-ray votes, and the rays it repaired are counted.
+nlohmann::json input_json(const std::string& file, const TriangleMesh& mesh, const BuildReport& build) {
+  return {{"file", file},
+          {"triangles", mesh.triangle_count()},
+          {"closed", build.input_closed},
+          {"boundary_edges", build.boundary_edges},
+          {"repaired_rays", build.repaired_rays},
+          {"degenerate_triangles", build.degenerate_triangles}};
 }
 
 void print_inputs(const nlohmann::json& report) {
@@ -39,7 +41,8 @@ void print_inputs(const nlohmann::json& report) {
     if (in["closed"].get<bool>()) {
       std::printf("closed\n");
     } else {
-      std::printf("open (%zu boundary edges): repaired by the half-ray votes\n", in["boundary_edges"].get<size_t>());
+      std::printf("open (%zu boundary edges): %zu rays repaired by the half-ray votes\n",
+                  in["boundary_edges"].get<size_t>(), in["repaired_rays"].get<size_t>());
     }
   }
 }
@@ -58,11 +61,12 @@ int run_boolean(const BooleanArgs& a, const CommonOptions& common) {
   if (!second.ok()) return fail("boolean", second.status());
   double load = t.seconds();
   ScopedTimer b(nullptr, "");
-  Result<World> w = mesh_boolean(first.value(), second.value(), op.value(), a.grid, a.config, bar.context());
+  std::array<BuildReport, 2> builds;
+  Result<World> w = mesh_boolean(first.value(), second.value(), op.value(), a.grid, a.config, bar.context(), &builds);
   if (!w.ok()) return fail("boolean", w.status());
   nlohmann::json report = {
       {"op", a.op},
-      {"inputs", nlohmann::json::array({input_json(a.first, first.value()), input_json(a.second, second.value())})},
+      {"inputs", nlohmann::json::array({input_json(a.first, first.value(), builds[0]), input_json(a.second, second.value(), builds[1])})},
       {"seconds", {{"load", load}, {"build_boolean", b.seconds()}}}};
   return contour_and_report("boolean", w.value(), a.mesh, bar, std::move(report), common, print_inputs);
 }
