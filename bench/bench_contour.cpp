@@ -14,8 +14,6 @@
 #include <vector>
 
 #include <openvdb/openvdb.h>
-#include <openvdb/tools/MeshToVolume.h>
-#include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/global_control.h>
 
 #include "bench_common.h"
@@ -24,6 +22,7 @@
 #include "ldc/build.h"
 #include "meshdist.h"
 #include "svg_plot.h"
+#include "vdb_mesh.h"
 
 namespace {
 
@@ -44,26 +43,8 @@ ldc::TriangleMesh ldc_remesh(const ldc::TriangleMesh& in, double h, const ldc::C
 }
 
 ldc::TriangleMesh vdb_remesh(const ldc::TriangleMesh& in, double h) {
-  std::vector<openvdb::Vec3s> points;
-  std::vector<openvdb::Vec3I> tris;
-  for (const auto& p : in.positions) points.emplace_back(float(p.x), float(p.y), float(p.z));
-  for (const auto& t : in.triangles) tris.emplace_back(t[0], t[1], t[2]);
   auto xform = openvdb::math::Transform::createLinearTransform(h);
-  std::vector<openvdb::Vec4I> no_quads;
-  auto grid = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, points, tris, no_quads, 3.0f);
-  std::vector<openvdb::Vec3s> out_points;
-  std::vector<openvdb::Vec3I> out_tris;
-  std::vector<openvdb::Vec4I> out_quads;
-  openvdb::tools::volumeToMesh(*grid, out_points, out_tris, out_quads, 0.0, 0.0);
-  ldc::TriangleMesh out;
-  for (const auto& p : out_points) out.positions.push_back({p.x(), p.y(), p.z()});
-  // volumeToMesh winds polygons inward: reverse them.
-  for (const auto& t : out_tris) out.triangles.push_back({t.z(), t.y(), t.x()});
-  for (const auto& q : out_quads) {
-    out.triangles.push_back({q.w(), q.z(), q.y()});
-    out.triangles.push_back({q.w(), q.y(), q.x()});
-  }
-  return out;
+  return ldc::bench::vdb_to_mesh(*ldc::bench::vdb_level_set(in, *xform));
 }
 
 std::vector<Method> methods() {

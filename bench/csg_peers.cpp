@@ -15,8 +15,8 @@
 #include <CGAL/Surface_mesh.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Composite.h>
-#include <openvdb/tools/MeshToVolume.h>
-#include <openvdb/tools/VolumeToMesh.h>
+
+#include "vdb_mesh.h"
 
 namespace ldc::bench {
 namespace {
@@ -131,16 +131,6 @@ CgalBooleanResult run_cgal(const TriangleMesh& a, const TriangleMesh& b, Boolean
   return r;
 }
 
-openvdb::FloatGrid::Ptr level_set(const TriangleMesh& m, const openvdb::math::Transform& xform) {
-  std::vector<openvdb::Vec3s> points;
-  std::vector<openvdb::Vec3I> tris;
-  points.reserve(m.positions.size());
-  tris.reserve(m.triangles.size());
-  for (const auto& p : m.positions) points.emplace_back(float(p.x), float(p.y), float(p.z));
-  for (const auto& t : m.triangles) tris.emplace_back(t[0], t[1], t[2]);
-  std::vector<openvdb::Vec4I> no_quads;
-  return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(xform, points, tris, no_quads, 3.0f);
-}
 
 }  // namespace
 
@@ -158,28 +148,14 @@ void vdb_initialize() { openvdb::initialize(); }
 
 TriangleMesh vdb_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, double h) {
   auto xform = openvdb::math::Transform::createLinearTransform(h);
-  openvdb::FloatGrid::Ptr ga = level_set(a, *xform), gb = level_set(b, *xform);
+  openvdb::FloatGrid::Ptr ga = vdb_level_set(a, *xform), gb = vdb_level_set(b, *xform);
   // Each leaves the result in its first argument and empties the second.
   switch (op) {
     case BooleanOp::kUnion: openvdb::tools::csgUnion(*ga, *gb); break;
     case BooleanOp::kDifference: openvdb::tools::csgDifference(*ga, *gb); break;
     case BooleanOp::kIntersection: openvdb::tools::csgIntersection(*ga, *gb); break;
   }
-  std::vector<openvdb::Vec3s> out_points;
-  std::vector<openvdb::Vec3I> out_tris;
-  std::vector<openvdb::Vec4I> out_quads;
-  openvdb::tools::volumeToMesh(*ga, out_points, out_tris, out_quads, 0.0, 0.0);
-  TriangleMesh out;
-  out.positions.reserve(out_points.size());
-  out.triangles.reserve(out_tris.size() + 2 * out_quads.size());
-  for (const auto& p : out_points) out.positions.push_back({p.x(), p.y(), p.z()});
-  // volumeToMesh winds polygons inward: reverse them (as bench_contour's vdb_remesh).
-  for (const auto& t : out_tris) out.triangles.push_back({t.z(), t.y(), t.x()});
-  for (const auto& q : out_quads) {
-    out.triangles.push_back({q.w(), q.z(), q.y()});
-    out.triangles.push_back({q.w(), q.y(), q.x()});
-  }
-  return out;
+  return vdb_to_mesh(*ga);
 }
 
 }  // namespace ldc::bench
