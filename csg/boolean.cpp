@@ -86,7 +86,7 @@ Result<World> boolean(const World& a, const World& b, BooleanOp op, const Boolea
     if (progress.cancelled()) return;
     glm::ivec3 c = slot_chunk(out, slot);
     // store_chunk writes only this slot: safe in parallel.
-    store_chunk(out, c, merge_chunk(view_chunk(a, c), view_chunk(b, c), op, config, out.chunk_size()));
+    store_chunk(out, c, merge_chunk(view_chunk(a, c), view_chunk(b, c), op, config, out.chunk_size(), false));
     progress.step();
   });
   if (progress.cancelled()) return cancelled_status("boolean");

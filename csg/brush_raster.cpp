@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "csg/detail/brush_raster.h"
+#include "ldc/detail/build_common.h"
 
 namespace ldc::detail {
 namespace {
@@ -163,23 +164,12 @@ class NoiseSphereSolid final : public ImplicitSolid {
   uint16_t material(const glm::dvec3&) const override { return material_; }
 
   WorldBox bounds() const override {
-    double e = n_.radius * (1.0 + n_.amplitude);
-    WorldBox b{glm::dvec3(INFINITY), glm::dvec3(-INFINITY)};
-    for (int i = 0; i < 8; ++i) {
-      glm::dvec3 corner((i & 1) ? e : -e, (i & 2) ? e : -e, (i & 4) ? e : -e);
-      glm::dvec3 w(transform_ * glm::dvec4(corner, 1.0));
-      b.min = glm::min(b.min, w);
-      b.max = glm::max(b.max, w);
-    }
-    return b;
+    return transformed_box_bounds(transform_, glm::dvec3(n_.radius * (1.0 + n_.amplitude)));
   }
 
   // Inside when all corners lie in the inner ball (its affine image is convex).
   BoxClass classify(const WorldBox& box) const override {
-    WorldBox b = bounds();
-    for (int a = 0; a < 3; ++a) {
-      if (box.max[a] < b.min[a] || box.min[a] > b.max[a]) return BoxClass::kOutside;
-    }
+    if (boxes_disjoint(box, bounds())) return BoxClass::kOutside;
     const double inner = n_.radius * (1.0 - n_.amplitude);
     for (int i = 0; i < 8; ++i) {
       glm::dvec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,

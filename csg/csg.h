@@ -150,7 +150,7 @@ class WorldEditor {
   // nothing changes) if a later edit changed one of the same chunks.
   Status undo(const EditReceipt& receipt);
 
-  // The chunks changed since the last call, and clears the list.
+  // The chunks changed since the last call, sorted by (z, y, x), and clears the list.
   std::vector<DirtyChunk> take_dirty();
 
  private:

@@ -28,7 +28,8 @@ struct EditSnapshot {
 namespace {
 
 // Chunk coordinates are within +-2^17 (kMaxNodeCoordinate / kMinChunkSize):
-// 21 bits each make a unique key.
+// 21 bits each, offset to be unsigned, make a unique key that orders chunks
+// by (z, y, x) as chunk_less does.
 uint64_t chunk_key(const glm::ivec3& c) {
   auto bits = [](int v) { return uint64_t(uint32_t(v + (1 << 20))) & 0x1FFFFFu; };
   return bits(c.x) | (bits(c.y) << 21) | (bits(c.z) << 42);
@@ -120,16 +121,16 @@ ChunkOutcome edit_chunk(const World& world, const glm::ivec3& c, const std::vect
   ChunkView current = view_chunk(world, c);
   ChunkOutcome out;
   out.merged.kind = current.kind;
-  out.merged.data = current.shared;
+  out.merged.data = current.data;
   for (const PreparedEdit& e : edits) {
     ChunkView b = view_chunk(e.brush, c);
     if (b.kind == ChunkKind::kEmpty && e.op != EditOp::kIntersect) continue;
     MergedChunk m = e.op == EditOp::kPaint ? paint_chunk(current, b, e.material, size)
-                                          : merge_chunk(current, b, boolean_of(e.op), config, size);
+                                          : merge_chunk(current, b, boolean_of(e.op), config, size, true);
     if (!m.changed_from_a) continue;
     out.changed = true;
     out.merged = m;
-    current = ChunkView{m.kind, m.data.get(), m.data};
+    current = ChunkView{m.kind, m.data};
     out.node_lo = glm::min(out.node_lo, chunk_lo + m.changed.lo);
     out.node_hi = glm::max(out.node_hi, chunk_lo + m.changed.hi);
   }
@@ -246,9 +247,8 @@ Status WorldEditor::undo(const EditReceipt& receipt) {
 std::vector<DirtyChunk> WorldEditor::take_dirty() {
   std::vector<DirtyChunk> out;
   out.reserve(dirty_.size());
-  for (auto& [key, d] : dirty_) out.push_back(d);
+  for (auto& [key, d] : dirty_) out.push_back(d);  // keys order the chunks by (z, y, x)
   dirty_.clear();
-  std::sort(out.begin(), out.end(), [](const DirtyChunk& a, const DirtyChunk& b) { return chunk_less(a.chunk, b.chunk); });
   return out;
 }
 

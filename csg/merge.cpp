@@ -171,12 +171,15 @@ struct FamilyChoice {
   ChangeBox changed;
 };
 
-MergedChunk finish_chunk(FamilyChoice& f, const ChunkView& a) {
+// Unchanged means no tracked change, or (untracked) every family is a's.
+MergedChunk finish_chunk(FamilyChoice& f, const ChunkView& a, bool tracked) {
   MergedChunk m;
   m.changed = f.changed;
-  if (f.changed.empty()) {
+  bool unchanged = f.changed.empty();
+  for (int k = 0; k < 3 && !tracked; ++k) unchanged = unchanged && f.pick[k] != &f.owned[k];
+  if (unchanged) {
     m.kind = a.kind;
-    m.data = a.shared;
+    m.data = a.data;
     m.changed_from_a = false;
     return m;
   }
@@ -196,15 +199,11 @@ MergedChunk finish_chunk(FamilyChoice& f, const ChunkView& a) {
 }  // namespace
 
 ChunkView view_chunk(const World& w, const glm::ivec3& chunk) {
-  ChunkView v;
-  v.kind = w.chunk_kind(chunk);
-  v.shared = w.chunk_shared(chunk);
-  v.data = v.shared.get();
-  return v;
+  return {w.chunk_kind(chunk), w.chunk_shared(chunk)};
 }
 
 MergedChunk merge_chunk(const ChunkView& a, const ChunkView& b, BooleanOp op, const BooleanConfig& config,
-                        int c) {
+                        int c, bool track_changes) {
   FamilyChoice f;
   std::array<RayFamily, 3> scratch_a, scratch_b;
   for (int k = 0; k < 3; ++k) {
@@ -220,10 +219,10 @@ MergedChunk merge_chunk(const ChunkView& a, const ChunkView& b, BooleanOp op, co
     } else {
       f.owned[k] = merge_family(fa, fb, op, config, c);
     }
-    note_family_change(fa, f.owned[k], k, c, f.changed);
+    if (track_changes) note_family_change(fa, f.owned[k], k, c, f.changed);
     f.pick[k] = &f.owned[k];
   }
-  return finish_chunk(f, a);
+  return finish_chunk(f, a, track_changes);
 }
 
 MergedChunk paint_chunk(const ChunkView& a, const ChunkView& b, uint16_t material, int c) {
@@ -252,7 +251,7 @@ MergedChunk paint_chunk(const ChunkView& a, const ChunkView& b, uint16_t materia
     f.pick[k] = &f.owned[k];
     note_family_change(fa, f.owned[k], k, c, f.changed);
   }
-  return finish_chunk(f, a);
+  return finish_chunk(f, a, /*tracked=*/true);
 }
 
 void store_chunk(World& w, const glm::ivec3& chunk, const MergedChunk& m) {

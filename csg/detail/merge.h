@@ -9,11 +9,11 @@
 
 namespace ldc::detail {
 
-// A chunk slot as a boolean reads it: its kind, and its data when mixed.
+// A chunk slot as a boolean reads it: its kind, and its data when mixed
+// (shared, to hand back unchanged chunks without copying).
 struct ChunkView {
   ChunkKind kind = ChunkKind::kEmpty;
-  const Chunk* data = nullptr;
-  std::shared_ptr<const Chunk> shared;  // to hand back unchanged chunks without copying
+  std::shared_ptr<const Chunk> data;
 };
 
 ChunkView view_chunk(const World& w, const glm::ivec3& chunk);
@@ -34,12 +34,15 @@ struct MergedChunk {
   ChunkKind kind = ChunkKind::kEmpty;
   std::shared_ptr<const Chunk> data;  // set when kind is kMixed
   bool changed_from_a = true;         // differs from the first input
-  ChangeBox changed;                  // where, when changed_from_a
+  ChangeBox changed;                  // where, when changed_from_a and tracked
 };
 
-// a op b for one chunk slot.
+// a op b for one chunk slot. With track_changes, `changed` holds the nodes
+// whose crossings changed and an unchanged result is a's own chunk; without
+// (whole-world booleans, which need no dirty boxes), the rays are not
+// compared and only families b leaves alone count as unchanged.
 MergedChunk merge_chunk(const ChunkView& a, const ChunkView& b, BooleanOp op, const BooleanConfig& config,
-                        int chunk_size);
+                        int chunk_size, bool track_changes);
 
 // a with the material of its surface points inside b replaced by `material`.
 MergedChunk paint_chunk(const ChunkView& a, const ChunkView& b, uint16_t material, int chunk_size);
