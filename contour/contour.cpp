@@ -61,17 +61,6 @@ bool chunk_is_quiet(const World& w, const glm::ivec3& ch) {
   return true;
 }
 
-void add_stats(ContourStats& into, const ContourStats& s) {
-  into.chunks_meshed += s.chunks_meshed;
-  into.cells += s.cells;
-  into.quads += s.quads;
-  into.multi_crossing_edges += s.multi_crossing_edges;
-  into.thin_edges += s.thin_edges;
-  into.clamped_vertices += s.clamped_vertices;
-  into.relaxed_vertices += s.relaxed_vertices;
-  for (int i = 0; i < 4; ++i) into.qef_rank[i] += s.qef_rank[i];
-}
-
 // The chunks to mesh: the world's, and one layer below it on each axis, whose
 // cells straddle the box's lower faces.
 std::vector<glm::ivec3> chunks_to_mesh(const World& w) {
@@ -102,7 +91,7 @@ Result<std::vector<ChunkMesh>> mesh_chunks(const World& w, const std::vector<glm
     }
     {
       std::lock_guard<std::mutex> lock(mutex);
-      add_stats(stats, local);
+      stats.add_counts(local);
     }
     size_t n = done.fetch_add(1) + 1;
     if (ctx && n % 16 == 0) ctx->report_progress("contour", double(n) / double(chunks.size()));
@@ -149,7 +138,7 @@ Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk, con
   if (!s.ok()) return s;
   ContourStats local;
   Result<std::vector<ChunkMesh>> r = mesh_chunks(world, {chunk}, config, nullptr, local);
-  if (stats) add_stats(*stats, local);
+  if (stats) stats->add_counts(local);
   if (!r.ok()) return r.status();
   if (r.value().empty()) {
     ChunkMesh empty;
@@ -195,7 +184,7 @@ Result<size_t> ChunkedMesh::update(const World& world, const std::vector<DirtyCh
     spliced += splice(patch);
   }
   stats.seconds = timer.seconds();
-  add_stats(stats_, stats);
+  stats_.add_counts(stats);
   return spliced;
 }
 
@@ -297,6 +286,17 @@ Result<ContourMesh> contour_one_piece(const World& world, const ContourConfig& c
 }
 
 }  // namespace
+
+void ContourStats::add_counts(const ContourStats& s) {
+  chunks_meshed += s.chunks_meshed;
+  cells += s.cells;
+  quads += s.quads;
+  multi_crossing_edges += s.multi_crossing_edges;
+  thin_edges += s.thin_edges;
+  clamped_vertices += s.clamped_vertices;
+  relaxed_vertices += s.relaxed_vertices;
+  for (int i = 0; i < 4; ++i) qef_rank[i] += s.qef_rank[i];
+}
 
 Result<ContourMesh> contour_world(const World& world, const ContourConfig& config, Context* ctx,
                                   ContourStats* stats) {

@@ -118,6 +118,9 @@ struct ContourStats {
   size_t clamped_vertices = 0;       // vertices the cell (plus slack) held back from their planes' optimum
   size_t relaxed_vertices = 0;       // vertices on a material border
   size_t qef_rank[4] = {0, 0, 0, 0};  // kQef: how many cells solved with rank 0..3
+
+  // Adds another run's counts to these (seconds are left as they are).
+  void add_counts(const ContourStats& other);
 };
 
 // Meshes the whole world.

@@ -117,14 +117,7 @@ MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm:
       p.triangles.push_back({{m.vertex_cell[tri.x], m.vertex_cell[tri.y], m.vertex_cell[tri.z]},
                              m.mesh.triangle_material[t]});
     }
-    ContourStats& st = piece_stats[s];
-    stats.cells += st.cells;
-    stats.quads += st.quads;
-    stats.multi_crossing_edges += st.multi_crossing_edges;
-    stats.thin_edges += st.thin_edges;
-    stats.clamped_vertices += st.clamped_vertices;
-    stats.relaxed_vertices += st.relaxed_vertices;
-    for (int i = 0; i < 4; ++i) stats.qef_rank[i] += st.qef_rank[i];
+    stats.add_counts(piece_stats[s]);
   }
   return p;
 }

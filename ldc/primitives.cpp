@@ -81,25 +81,12 @@ class PrimitiveSolid final : public ImplicitSolid {
 
   uint16_t material(const glm::dvec3&) const override { return p_.material; }
 
-  WorldBox bounds() const override {
-    glm::dvec3 e = local_half_extent();
-    WorldBox b{glm::dvec3(kInf), glm::dvec3(-kInf)};
-    for (int i = 0; i < 8; ++i) {
-      glm::dvec3 corner((i & 1) ? e.x : -e.x, (i & 2) ? e.y : -e.y, (i & 4) ? e.z : -e.z);
-      glm::dvec3 w = glm::dvec3(p_.transform * glm::dvec4(corner, 1.0));
-      b.min = glm::min(b.min, w);
-      b.max = glm::max(b.max, w);
-    }
-    return b;
-  }
+  WorldBox bounds() const override { return detail::transformed_box_bounds(p_.transform, local_half_extent()); }
 
   // Outside when the box misses the bounds; inside when all eight corners are
   // inside (the shapes are convex, and so are their affine images).
   BoxClass classify(const WorldBox& box) const override {
-    WorldBox b = bounds();
-    for (int a = 0; a < 3; ++a) {
-      if (box.max[a] < b.min[a] || box.min[a] > b.max[a]) return BoxClass::kOutside;
-    }
+    if (detail::boxes_disjoint(box, bounds())) return BoxClass::kOutside;
     for (int i = 0; i < 8; ++i) {
       glm::dvec3 c((i & 1) ? box.max.x : box.min.x, (i & 2) ? box.max.y : box.min.y,
                    (i & 4) ? box.max.z : box.min.z);

@@ -139,31 +139,33 @@ class NoiseLayer {
     return c;
   }
 
-  LDC_TERRAIN_INLINE static double blend_value(const Cell& c) {
+  // The corner gradients of a cell and their dot products with the offsets
+  // from the corners: what both blends start from.
+  struct Corners {
+    const std::array<double, 2>&g00, &g10, &g01, &g11;
+    double d00, d10, d01, d11;
+  };
+  LDC_TERRAIN_INLINE static Corners corners(const Cell& c) {
     const auto& g00 = kGrad2[c.h[0] & 15u];
     const auto& g10 = kGrad2[c.h[1] & 15u];
     const auto& g01 = kGrad2[c.h[2] & 15u];
     const auto& g11 = kGrad2[c.h[3] & 15u];
     const double tx = c.tx, ty = c.ty;
-    const double d00 = g00[0] * tx + g00[1] * ty;
-    const double d10 = g10[0] * (tx - 1.0) + g10[1] * ty;
-    const double d01 = g01[0] * tx + g01[1] * (ty - 1.0);
-    const double d11 = g11[0] * (tx - 1.0) + g11[1] * (ty - 1.0);
-    const double u = fade(tx), v = fade(ty);
+    return {g00, g10, g01, g11,
+            g00[0] * tx + g00[1] * ty, g10[0] * (tx - 1.0) + g10[1] * ty,
+            g01[0] * tx + g01[1] * (ty - 1.0), g11[0] * (tx - 1.0) + g11[1] * (ty - 1.0)};
+  }
+
+  LDC_TERRAIN_INLINE static double blend_value(const Cell& c) {
+    const auto [g00, g10, g01, g11, d00, d10, d01, d11] = corners(c);
+    const double u = fade(c.tx), v = fade(c.ty);
     const double a = d00 + u * (d10 - d00), b = d01 + u * (d11 - d01);
     return a + v * (b - a);
   }
 
   LDC_TERRAIN_INLINE static Noise2 blend(const Cell& c) {
-    const auto& g00 = kGrad2[c.h[0] & 15u];
-    const auto& g10 = kGrad2[c.h[1] & 15u];
-    const auto& g01 = kGrad2[c.h[2] & 15u];
-    const auto& g11 = kGrad2[c.h[3] & 15u];
+    const auto [g00, g10, g01, g11, d00, d10, d01, d11] = corners(c);
     const double tx = c.tx, ty = c.ty;
-    const double d00 = g00[0] * tx + g00[1] * ty;
-    const double d10 = g10[0] * (tx - 1.0) + g10[1] * ty;
-    const double d01 = g01[0] * tx + g01[1] * (ty - 1.0);
-    const double d11 = g11[0] * (tx - 1.0) + g11[1] * (ty - 1.0);
     const double u = fade(tx), v = fade(ty);
     const double k1 = d10 - d00, k2 = d01 - d00, k3 = d00 - d10 - d01 + d11;
     Noise2 n;

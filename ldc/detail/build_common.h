@@ -4,6 +4,7 @@
 
 #include <array>
 #include <atomic>
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,25 @@ class ProgressCounter {
   size_t total_;
   std::atomic<size_t> done_{0};
 };
+
+// Bounds of the box [-half, half] under an affine map: its eight corners'.
+inline WorldBox transformed_box_bounds(const glm::dmat4& transform, const glm::dvec3& half) {
+  WorldBox b{glm::dvec3(INFINITY), glm::dvec3(-INFINITY)};
+  for (int i = 0; i < 8; ++i) {
+    glm::dvec3 corner((i & 1) ? half.x : -half.x, (i & 2) ? half.y : -half.y, (i & 4) ? half.z : -half.z);
+    glm::dvec3 w(transform * glm::dvec4(corner, 1.0));
+    b.min = glm::min(b.min, w);
+    b.max = glm::max(b.max, w);
+  }
+  return b;
+}
+
+inline bool boxes_disjoint(const WorldBox& a, const WorldBox& b) {
+  for (int k = 0; k < 3; ++k) {
+    if (a.max[k] < b.min[k] || a.min[k] > b.max[k]) return true;
+  }
+  return false;
+}
 
 inline Status cancelled_status(const char* what) {
   return {ErrorCode::kCancelled, std::string(what) + ": cancelled"};
