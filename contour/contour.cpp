@@ -6,7 +6,6 @@
 #include <cmath>
 #include <mutex>
 #include <new>
-#include <set>
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -200,28 +199,27 @@ size_t ChunkedMesh::splice(const detail::MeshPatch& patch) {
   for (int z = first.z; z <= last.z; ++z)
     for (int y = first.y; y <= last.y; ++y)
       for (int x = first.x; x <= last.x; ++x) targets.emplace_back(x, y, z);
-  auto find = [&](const glm::ivec3& ch) -> const ChunkMesh* {
-    auto it = std::lower_bound(chunks_.begin(), chunks_.end(), ch,
+  auto less = [](const ChunkMesh& a, const ChunkMesh& b) { return chunk_less(a.chunk, b.chunk); };
+  const size_t kept = chunks_.size();  // the sorted part; chunks new to the mesh are appended below
+  auto find = [&](const glm::ivec3& ch) -> ChunkMesh* {
+    auto end = chunks_.begin() + long(kept);
+    auto it = std::lower_bound(chunks_.begin(), end, ch,
                                [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_less(m.chunk, k); });
-    return it != chunks_.end() && it->chunk == ch ? &*it : nullptr;
+    return it != end && it->chunk == ch ? &*it : nullptr;
   };
   std::vector<ChunkMesh> spliced(targets.size());
   tbb::parallel_for(size_t{0}, targets.size(), [&](size_t i) {
     const ChunkMesh* old = find(targets[i]);
     spliced[i] = detail::splice_patch(old ? *old : ChunkMesh{}, patch, targets[i], c);
   });
-  std::vector<ChunkMesh> merged;
-  merged.reserve(chunks_.size() + targets.size());
-  auto less = [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); };
-  std::set<glm::ivec3, decltype(less)> replaced(targets.begin(), targets.end(), less);
-  for (ChunkMesh& m : chunks_) {
-    if (!replaced.count(m.chunk)) merged.push_back(std::move(m));
+  // Replace in place; chunks new to the mesh are merged in, and chunks left
+  // without vertices dropped, keeping chunks_ sorted.
+  for (size_t i = 0; i < targets.size(); ++i) {
+    if (ChunkMesh* old = find(targets[i])) *old = std::move(spliced[i]);
+    else if (!spliced[i].mesh.positions.empty()) chunks_.push_back(std::move(spliced[i]));
   }
-  for (ChunkMesh& m : spliced) {
-    if (!m.mesh.positions.empty()) merged.push_back(std::move(m));
-  }
-  std::sort(merged.begin(), merged.end(), [](const ChunkMesh& a, const ChunkMesh& b) { return chunk_less(a.chunk, b.chunk); });
-  chunks_ = std::move(merged);
+  std::inplace_merge(chunks_.begin(), chunks_.begin() + long(kept), chunks_.end(), less);
+  std::erase_if(chunks_, [](const ChunkMesh& m) { return m.mesh.positions.empty(); });
   return targets.size();
 }
 
