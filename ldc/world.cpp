@@ -1,5 +1,6 @@
 #include "ldc/world.h"
 
+#include <atomic>
 #include <algorithm>
 #include <bit>
 #include <cassert>
@@ -192,6 +193,11 @@ Status check_world_config(const WorldConfig& config) {
 
 }  // namespace
 
+void ContentStamp::renew() {
+  static std::atomic<uint64_t> next{1};
+  value_.store(next.fetch_add(1, std::memory_order_relaxed), std::memory_order_relaxed);
+}
+
 World::World() : World(WorldConfig{}) {}
 
 World::World(const WorldConfig& config) : config_(config) {
@@ -255,6 +261,7 @@ Status World::grow_to_include(const glm::ivec3& lo, const glm::ivec3& hi) {
   config_ = grown;
   kinds_ = std::move(bigger.kinds_);
   chunks_ = std::move(bigger.chunks_);
+  stamp_.renew();
   return {};
 }
 
@@ -268,6 +275,7 @@ void World::set_chunk(const glm::ivec3& c, std::shared_ptr<const Chunk> data) {
   size_t slot = chunk_slot(c);
   kinds_[slot] = ChunkKind::kMixed;
   chunks_[slot] = std::move(data);
+  stamp_.renew();
 }
 
 void World::set_uniform_chunk(const glm::ivec3& c, bool solid) {
@@ -275,6 +283,7 @@ void World::set_uniform_chunk(const glm::ivec3& c, bool solid) {
   size_t slot = chunk_slot(c);
   kinds_[slot] = solid ? ChunkKind::kSolid : ChunkKind::kEmpty;
   chunks_[slot].reset();
+  stamp_.renew();
 }
 
 void World::for_each_chunk(

@@ -30,6 +30,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -219,6 +220,25 @@ struct WorldStats {
   }
 };
 
+// A number naming a world's content: it changes whenever chunks or the box
+// change and is unique across the process, so two worlds with equal stamps
+// hold the same chunks (one is a copy of the other). Queries use it to know
+// that what they derived from the chunks is still current.
+class ContentStamp {
+ public:
+  ContentStamp() { renew(); }
+  ContentStamp(const ContentStamp& other) : value_(other.value()) {}
+  ContentStamp& operator=(const ContentStamp& other) {
+    value_.store(other.value(), std::memory_order_relaxed);
+    return *this;
+  }
+  uint64_t value() const { return value_.load(std::memory_order_relaxed); }
+  void renew();
+
+ private:
+  std::atomic<uint64_t> value_{0};
+};
+
 struct WorldBox {
   glm::dvec3 min{0.0};
   glm::dvec3 max{0.0};
@@ -283,6 +303,9 @@ class World {
   std::optional<WorldBox> solid_bounds() const;
   WorldStats stats() const;
 
+  // Changes with every set_chunk, set_uniform_chunk and grow_to_include.
+  uint64_t stamp() const { return stamp_.value(); }
+
   // Free-form key/value notes saved with the world (source file, build report).
   std::vector<std::pair<std::string, std::string>>& metadata() { return metadata_; }
   const std::vector<std::pair<std::string, std::string>>& metadata() const { return metadata_; }
@@ -292,6 +315,7 @@ class World {
  private:
   explicit World(const WorldConfig& config);
   WorldConfig config_;
+  ContentStamp stamp_;
   std::vector<ChunkKind> kinds_;
   std::vector<std::shared_ptr<const Chunk>> chunks_;
   std::vector<std::pair<std::string, std::string>> metadata_;

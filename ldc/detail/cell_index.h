@@ -1,0 +1,124 @@
+// What queries derive from the span lists: per chunk, which cells hold
+// surface and which are inside (CellIndex); per surface cell, the tangent
+// planes of the points on its twelve edges (CellSurface); and the walk of a
+// ray through the cells that skips bricks and chunks without surface.
+#pragma once
+
+#include <array>
+#include <atomic>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "ldc/world.h"
+
+namespace ldc {
+class Queries;
+}
+
+namespace ldc::detail {
+
+// The chunk's own data and the neighbours whose rays hold edges of its cells:
+// +x, +y, +z, +xy, +yz, +zx.
+inline constexpr int kIndexSources = 7;
+inline const std::array<glm::ivec3, kIndexSources> kIndexSourceOffsets = {
+    glm::ivec3(0, 0, 0), glm::ivec3(1, 0, 0), glm::ivec3(0, 1, 0), glm::ivec3(0, 0, 1),
+    glm::ivec3(1, 1, 0), glm::ivec3(0, 1, 1), glm::ivec3(1, 0, 1)};
+
+inline constexpr int kBrickShift = 2;  // bricks of 4^3 cells
+
+// The cells of one chunk: cell (i, j, k) spans nodes i..i+1, j..j+1, k..k+1
+// (local), so the cells at the far faces need the neighbours' rays.
+struct CellIndex {
+  std::array<const Chunk*, kIndexSources> sources{};
+  std::array<ChunkKind, kIndexSources> kinds{};
+  std::array<std::shared_ptr<const Chunk>, kIndexSources> keep;  // keeps the addresses unique
+  std::atomic<uint64_t> checked_stamp{0};  // world stamp at which the sources were last current
+
+  int size = 0;               // C
+  bool clear = false;         // no surface cell: every cell is inside (clear_inside) or outside
+  bool clear_inside = false;
+  std::vector<uint64_t> surface;  // word z*C + y, bit x: the cell has points on an edge
+  std::vector<uint64_t> inside;   // same layout: the cell's first corner is inside
+  std::vector<uint64_t> bricks;   // bit per brick (bz*B + by)*B + bx: not wholly outside
+
+  bool is_surface(const glm::ivec3& l) const { return (surface[size_t(l.z) * size + l.y] >> l.x) & 1u; }
+  bool is_inside(const glm::ivec3& l) const { return (inside[size_t(l.z) * size + l.y] >> l.x) & 1u; }
+  bool brick_busy(const glm::ivec3& l) const {
+    const int b = size >> kBrickShift;
+    const glm::ivec3 k = l >> kBrickShift;
+    const size_t bit = (size_t(k.z) * b + k.y) * b + k.x;
+    return (bricks[bit >> 6] >> (bit & 63)) & 1u;
+  }
+  size_t memory_bytes() const;
+};
+
+// Whether the index still describes chunk c of the world.
+bool index_current(const CellIndex& index, const World& world, const glm::ivec3& c);
+std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3& c);
+
+// One tangent plane: a surface point (cell-local coordinates, cells) and its normal.
+struct CellPlane {
+  glm::dvec3 p{0.0};
+  glm::dvec3 n{0.0};
+  uint16_t material = 0;
+};
+
+enum class CellShape : uint8_t {
+  kConvex,   // solid = intersection of the planes' inner half-spaces
+  kConcave,  // solid = union of them
+  kPlane,    // neither: one averaged plane (planes[0])
+};
+
+// The surface in one cell, in coordinates local to the cell (its first node at 0).
+struct CellSurface {
+  static constexpr int kMaxPlanes = 24;
+  std::array<CellPlane, kMaxPlanes> planes;
+  int count = 0;
+  CellShape shape = CellShape::kConvex;
+
+  // Signed distance-like value: <= 0 inside the solid model [Units: cells].
+  double inside_value(const glm::dvec3& x, int* plane = nullptr) const;
+  bool contains(const glm::dvec3& x) const { return inside_value(x) <= 0.0; }
+};
+
+// Gathers the points on the cell's twelve edges (cell = its first node, global)
+// and classifies their planes. Returns false when the cell holds no point.
+bool gather_cell_surface(const World& world, const glm::ivec3& cell, CellSurface* out);
+
+// First entry of x(t) = o + t*d into the cell's solid for t in [t0, t1]
+// (cell-local o). `plane` is the plane entered (its normal is the hit normal).
+struct CellHit {
+  bool hit = false;
+  double t = 0.0;
+  int plane = 0;
+};
+CellHit intersect_cell(const CellSurface& surface, const glm::dvec3& o, const glm::dvec3& d, double t0,
+                       double t1);
+
+// Nearest point of the cell's surface to x (cell-local), searched within the
+// cell's box [0,1]^3; false when the model has no surface in the box.
+struct CellClosest {
+  glm::dvec3 point{0.0};
+  double distance2 = 0.0;
+  int plane = 0;
+};
+bool closest_in_cell(const CellSurface& surface, const glm::dvec3& x, CellClosest* out);
+
+// What the walk reports for a cell that is not wholly outside.
+enum class CellKind : uint8_t { kSurface, kInside };
+
+// Walks the cells of x(t) = o + t*d (lattice coordinates, d in cells per unit
+// of t) for t in [t_begin, t_end], in order, skipping bricks and chunks with
+// no surface and nothing inside. visit(cell, kind, t0, t1, entry_axis) returns
+// true to stop; entry_axis is the axis of the face the walk entered the cell
+// through (-1 for the first cell).
+template <class Visit>
+void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o, const glm::dvec3& d,
+                double t_begin, double t_end, Visit&& visit);
+
+}  // namespace ldc::detail
+
+#include "ldc/detail/cell_walk.h"
