@@ -279,18 +279,32 @@ CellHit intersect_cell(const CellSurface& s, const glm::dvec3& o, const glm::dve
 }
 
 bool closest_in_cell(const CellSurface& s, const glm::dvec3& x, CellClosest* out) {
-  // Candidates: x projected on each plane and clamped to the cell, kept when
-  // it lies on the model's boundary; and the stored points themselves.
   bool found = false;
   auto consider = [&](const glm::dvec3& q, int plane) {
     const double d2 = glm::dot(q - x, q - x);
     if (!found || d2 < out->distance2) *out = CellClosest{q, d2, plane}, found = true;
   };
-  constexpr double kOnSurface = 1e-3;  // cells
+  auto in_cell = [](const glm::dvec3& q, double slack) {
+    return glm::all(glm::greaterThanEqual(q, glm::dvec3(-slack))) &&
+           glm::all(glm::lessThanEqual(q, glm::dvec3(1.0 + slack)));
+  };
+  // The plane the model's value comes from (convex: the largest, concave: the
+  // smallest) is the nearest face in its region: project x onto it.
+  int k = 0;
+  const double value = s.inside_value(x, &k);
+  const glm::dvec3 q = x - s.planes[size_t(k)].n * value;
+  constexpr double kOnSurface = 0.02, kSlack = 0.1;  // cells
+  if (in_cell(q, kSlack) && std::abs(s.inside_value(q)) <= kOnSurface) {
+    consider(q, k);
+    return true;
+  }
+  // Near an edge or corner of the model: the other projections that stay on
+  // it, clamped to the cell, and the stored points themselves.
   for (int i = 0; i < s.count; ++i) {
     const CellPlane& pl = s.planes[size_t(i)];
-    glm::dvec3 q = glm::clamp(x - pl.n * glm::dot(pl.n, x - pl.p), glm::dvec3(0.0), glm::dvec3(1.0));
-    if (std::abs(s.inside_value(q)) <= kOnSurface) consider(q, i);
+    glm::dvec3 p = glm::clamp(x - pl.n * glm::dot(pl.n, x - pl.p), glm::dvec3(0.0), glm::dvec3(1.0));
+    p -= pl.n * glm::dot(pl.n, p - pl.p);  // back onto the plane
+    if (in_cell(p, kSlack) && std::abs(s.inside_value(p)) <= kOnSurface) consider(p, i);
     consider(pl.p, i);  // a stored point, or the centre of the averaged plane
   }
   return found;

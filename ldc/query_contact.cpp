@@ -1,22 +1,337 @@
-// Queries: closest points, overlaps and sphere casts.
+// Queries: closest points, overlaps and sphere casts, all read from the same
+// per-cell tangent-plane solids as ray casts (detail/cell_index.h).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "ldc/detail/cell_index.h"
+#include "ldc/detail/ray_math.h"
 #include "ldc/query.h"
 
 namespace ldc {
+namespace {
 
-Result<RayHit> Queries::sphere_cast(const Ray&, double) const {
-  return Status(ErrorCode::kUnsupported, "sphere_cast: not written yet");
+using detail::CellIndex;
+using detail::CellSurface;
+
+constexpr double kMaxSearchCells = 64.0;  // closest_point's search limit
+constexpr double kContactGap = 0.01;      // cells: a sphere this close touches
+constexpr int kMaxCastSteps = 4096;
+
+bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::string vec_text(const glm::dvec3& v) {
+  std::ostringstream s;
+  s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
+  return s.str();
 }
-Result<Overlap> Queries::overlap(const glm::dvec3&, double) const {
-  return Status(ErrorCode::kUnsupported, "overlap: not written yet");
+
+Status check_point(const char* what, const glm::dvec3& p) {
+  if (finite3(p)) return {};
+  return {ErrorCode::kInvalidArgument, std::string(what) + " " + vec_text(p) + " is not finite"};
 }
-Result<Overlap> Queries::overlap(const OrientedBox&) const {
-  return Status(ErrorCode::kUnsupported, "overlap: not written yet");
+
+Status check_positive(const char* what, double value) {
+  if (value > 0.0 && std::isfinite(value)) return {};
+  std::ostringstream s;
+  s << what << " " << value << " must be finite and > 0";
+  return {ErrorCode::kInvalidArgument, s.str()};
 }
-Result<Overlap> Queries::overlap(const Capsule&) const {
-  return Status(ErrorCode::kUnsupported, "overlap: not written yet");
+
+// The nearest surface point found so far, in lattice coordinates.
+struct Nearest {
+  bool found = false;
+  glm::dvec3 point{0.0};
+  glm::dvec3 normal{0.0};
+  uint16_t material = 0;
+  double distance2 = 0.0;
+};
+
+double box_distance2(const glm::dvec3& x, const glm::dvec3& lo, const glm::dvec3& hi) {
+  const glm::dvec3 d = glm::max(glm::max(lo - x, x - hi), glm::dvec3(0.0));
+  return glm::dot(d, d);
 }
-Result<ClosestPoint> Queries::closest_point(const glm::dvec3&, double) const {
-  return Status(ErrorCode::kUnsupported, "closest_point: not written yet");
+
+glm::ivec3 chunk_of(const glm::ivec3& cell, int c) {
+  return {detail::floor_div(cell.x, c), detail::floor_div(cell.y, c), detail::floor_div(cell.z, c)};
+}
+
+// Calls fn(cell, index) for every surface cell in [lo, hi] (inclusive), chunk
+// by chunk, skipping chunks and bricks without surface.
+template <class Fn>
+void for_surface_cells(const Queries& q, const glm::ivec3& lo, const glm::ivec3& hi, Fn&& fn) {
+  const int c = q.world().chunk_size();
+  const glm::ivec3 box_lo = q.world().node_min() - 1, box_hi = q.world().node_end() - 1;
+  const glm::ivec3 clo = glm::max(lo, box_lo), chi = glm::min(hi, box_hi);
+  if (glm::any(glm::greaterThan(clo, chi))) return;
+  const glm::ivec3 k_lo = chunk_of(clo, c), k_hi = chunk_of(chi, c);
+  for (int kz = k_lo.z; kz <= k_hi.z; ++kz)
+    for (int ky = k_lo.y; ky <= k_hi.y; ++ky)
+      for (int kx = k_lo.x; kx <= k_hi.x; ++kx) {
+        const glm::ivec3 k(kx, ky, kz);
+        const CellIndex* index = q.cell_index(k);
+        if (index->clear) continue;
+        const glm::ivec3 a = glm::max(clo, k * c), b = glm::min(chi, k * c + (c - 1));
+        for (int z = a.z; z <= b.z; ++z)
+          for (int y = a.y; y <= b.y; ++y)
+            for (int x = a.x; x <= b.x; ++x) {
+              const glm::ivec3 l = glm::ivec3(x, y, z) - k * c;
+              if (!index->brick_busy(l)) {
+                x |= (1 << detail::kBrickShift) - 1;  // skip the rest of the brick's row
+                continue;
+              }
+              if (index->is_surface(l)) fn(glm::ivec3(x, y, z));
+            }
+      }
+}
+
+// Nearest surface point to x within `radius` cells, searching outwards.
+Nearest nearest_surface(const Queries& q, const glm::dvec3& x, double radius) {
+  Nearest best;
+  CellSurface surface;
+  double reach = std::min(2.0, radius);
+  for (;;) {
+    const glm::ivec3 lo(glm::floor(x - reach)), hi(glm::floor(x + reach));
+    for_surface_cells(q, lo, hi, [&](const glm::ivec3& cell) {
+      const glm::dvec3 cell_lo(cell);
+      if (best.found && box_distance2(x, cell_lo, cell_lo + 1.0) >= best.distance2) return;
+      if (!detail::gather_cell_surface(q.world(), cell, &surface)) return;
+      detail::CellClosest cc;
+      if (!detail::closest_in_cell(surface, x - cell_lo, &cc)) return;
+      if (best.found && cc.distance2 >= best.distance2) return;
+      const detail::CellPlane& plane = surface.planes[size_t(cc.plane)];
+      best = Nearest{true, cell_lo + cc.point, plane.n, plane.material, cc.distance2};
+    });
+    if ((best.found && best.distance2 <= reach * reach) || reach >= radius) break;
+    reach = std::min(2.0 * reach, radius);
+  }
+  if (best.found && best.distance2 > radius * radius) best.found = false;
+  return best;
+}
+
+// Whether a lattice position is inside the query solid.
+bool inside_solid(const Queries& q, const glm::dvec3& x) {
+  const int c = q.world().chunk_size();
+  const glm::ivec3 cell(glm::floor(x));
+  const glm::ivec3 k = chunk_of(cell, c);
+  const CellIndex* index = q.cell_index(k);
+  if (index->clear) return index->clear_inside;
+  const glm::ivec3 l = cell - k * c;
+  if (!index->is_surface(l)) return index->is_inside(l);
+  CellSurface surface;
+  if (!detail::gather_cell_surface(q.world(), cell, &surface)) return index->is_inside(l);
+  return surface.contains(x - glm::dvec3(cell));
+}
+
+// A convex shape for overlap tests, in lattice coordinates.
+struct ConvexShape {
+  virtual ~ConvexShape() = default;
+  virtual glm::dvec3 support(const glm::dvec3& dir) const = 0;  // farthest point along dir
+  virtual bool contains(const glm::dvec3& x) const = 0;
+  virtual glm::dvec3 centre() const = 0;
+};
+
+struct BoxShape : ConvexShape {
+  glm::dvec3 c, e;
+  glm::dmat3 r;
+  glm::dvec3 support(const glm::dvec3& dir) const override {
+    glm::dvec3 s = c;
+    for (int a = 0; a < 3; ++a) s += r[a] * (glm::dot(r[a], dir) >= 0.0 ? e[a] : -e[a]);
+    return s;
+  }
+  bool contains(const glm::dvec3& x) const override {
+    for (int a = 0; a < 3; ++a)
+      if (std::abs(glm::dot(r[a], x - c)) > e[a]) return false;
+    return true;
+  }
+  glm::dvec3 centre() const override { return c; }
+};
+
+struct CapsuleShape : ConvexShape {
+  glm::dvec3 a, b;
+  double radius;
+  glm::dvec3 support(const glm::dvec3& dir) const override {
+    const double len = glm::length(dir);
+    const glm::dvec3 u = len > 0.0 ? dir / len : glm::dvec3(0.0);
+    return (glm::dot(b - a, u) >= 0.0 ? b : a) + radius * u;
+  }
+  bool contains(const glm::dvec3& x) const override {
+    const glm::dvec3 ab = b - a;
+    const double len2 = glm::dot(ab, ab);
+    const double t = len2 > 0.0 ? std::clamp(glm::dot(x - a, ab) / len2, 0.0, 1.0) : 0.0;
+    const glm::dvec3 d = x - (a + t * ab);
+    return glm::dot(d, d) <= radius * radius;
+  }
+  glm::dvec3 centre() const override { return 0.5 * (a + b); }
+};
+
+// Deepest contact of a convex shape with the surface planes near it: for each
+// plane, how deep the shape's support point lies behind it, kept when that
+// contact lies on the surface within its own cell. Lattice units.
+Overlap shape_overlap(const Queries& q, const ConvexShape& shape, double h) {
+  Overlap out;
+  glm::dvec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    glm::dvec3 axis(0.0);
+    axis[a] = 1.0;
+    hi[a] = shape.support(axis)[a];
+    lo[a] = shape.support(-axis)[a];
+  }
+  constexpr double kSlack = 0.25;  // cells around a plane's own cell where its contact may lie
+  double deepest = 0.0;
+  bool touching = false;
+  CellSurface surface;
+  for_surface_cells(q, glm::ivec3(glm::floor(lo)) - 1, glm::ivec3(glm::floor(hi)) + 1, [&](const glm::ivec3& cell) {
+    if (!detail::gather_cell_surface(q.world(), cell, &surface)) return;
+    const glm::dvec3 base(cell);
+    for (int i = 0; i < surface.count; ++i) {
+      const detail::CellPlane& pl = surface.planes[size_t(i)];
+      const glm::dvec3 p = base + pl.p;
+      const glm::dvec3 s = shape.support(-pl.n);
+      const double depth = glm::dot(pl.n, p - s);
+      if (depth < 0.0) continue;
+      // The contact: the support point moved onto the plane; it must lie on this cell's surface.
+      const glm::dvec3 contact = s + depth * pl.n - base;
+      const bool local = glm::all(glm::greaterThanEqual(contact, glm::dvec3(-kSlack))) &&
+                         glm::all(glm::lessThanEqual(contact, glm::dvec3(1.0 + kSlack))) &&
+                         surface.inside_value(contact) <= kSlack;
+      if (!local && !shape.contains(p)) continue;
+      touching = true;
+      if (depth > deepest || out.depth == 0.0) {
+        deepest = depth;
+        out.depth = depth * h;
+        out.normal = glm::vec3(pl.n);
+        out.point = q.world().lattice().to_world(s + depth * pl.n);
+      }
+    }
+  });
+  out.overlaps = touching || inside_solid(q, shape.centre());
+  return out;
+}
+
+}  // namespace
+
+Result<ClosestPoint> Queries::closest_point(const glm::dvec3& p, double max_distance) const {
+  Status s = check_point("closest_point: point", p);
+  if (!s.ok()) return s;
+  const double h = world_->lattice().cell_size;
+  if (!(max_distance >= 0.0) || max_distance > kMaxSearchCells * h) {
+    std::ostringstream m;
+    m << "closest_point: max_distance " << max_distance << " m must be in [0, " << kMaxSearchCells * h
+      << "] (64 cells of " << h << " m)";
+    return Status(ErrorCode::kInvalidArgument, m.str());
+  }
+  const glm::dvec3 x = world_->lattice().to_lattice(p);
+  ClosestPoint out;
+  out.query_inside = inside_solid(*this, x);
+  Nearest n = nearest_surface(*this, x, max_distance / h);
+  if (!n.found) return out;
+  out.found = true;
+  out.point = world_->lattice().to_world(n.point);
+  out.normal = glm::vec3(n.normal);
+  out.material = n.material;
+  out.distance = std::sqrt(n.distance2) * h;
+  return out;
+}
+
+Result<Overlap> Queries::overlap(const glm::dvec3& center, double radius) const {
+  Status s = check_point("overlap: sphere centre", center);
+  if (s.ok()) s = check_positive("overlap: sphere radius", radius);
+  if (!s.ok()) return s;
+  const double h = world_->lattice().cell_size;
+  const glm::dvec3 x = world_->lattice().to_lattice(center);
+  const double r = radius / h;
+  const bool inside = inside_solid(*this, x);
+  // Inside, the sphere must move out by its radius past the nearest surface.
+  Nearest n = nearest_surface(*this, x, inside ? kMaxSearchCells : r);
+  Overlap out;
+  if (!inside && !n.found) return out;
+  out.overlaps = true;
+  if (!n.found) {  // deep inside: at least this deep
+    out.depth = (r + kMaxSearchCells) * h;
+    out.normal = glm::vec3(0.0f, 0.0f, 1.0f);
+    out.point = center;
+    return out;
+  }
+  const double dist = std::sqrt(n.distance2);
+  out.depth = (inside ? r + dist : r - dist) * h;
+  glm::dvec3 away = inside ? n.point - x : x - n.point;
+  out.normal = glm::vec3(dist > 1e-6 ? away / dist : n.normal);
+  out.point = world_->lattice().to_world(n.point);
+  return out;
+}
+
+Result<Overlap> Queries::overlap(const OrientedBox& box) const {
+  Status s = check_point("overlap: box centre", box.center);
+  for (int a = 0; a < 3 && s.ok(); ++a) s = check_positive("overlap: box half extent", box.half_extents[a]);
+  if (!s.ok()) return s;
+  const glm::dmat3 rtr = glm::transpose(box.rotation) * box.rotation;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (!(std::abs(rtr[i][j] - (i == j ? 1.0 : 0.0)) <= 1e-6))
+        return Status(ErrorCode::kInvalidArgument, "overlap: box rotation is not orthonormal");
+  const double h = world_->lattice().cell_size;
+  BoxShape shape;
+  shape.c = world_->lattice().to_lattice(box.center);
+  shape.e = box.half_extents / h;
+  shape.r = box.rotation;
+  return shape_overlap(*this, shape, h);
+}
+
+Result<Overlap> Queries::overlap(const Capsule& capsule) const {
+  Status s = check_point("overlap: capsule end a", capsule.a);
+  if (s.ok()) s = check_point("overlap: capsule end b", capsule.b);
+  if (s.ok()) s = check_positive("overlap: capsule radius", capsule.radius);
+  if (!s.ok()) return s;
+  const double h = world_->lattice().cell_size;
+  CapsuleShape shape;
+  shape.a = world_->lattice().to_lattice(capsule.a);
+  shape.b = world_->lattice().to_lattice(capsule.b);
+  shape.radius = capsule.radius / h;
+  return shape_overlap(*this, shape, h);
+}
+
+Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
+  Status s = check_point("sphere_cast: origin", ray.origin);
+  if (s.ok()) s = check_point("sphere_cast: direction", ray.direction);
+  if (s.ok() && !(glm::length(ray.direction) > 1e-300))
+    s = Status(ErrorCode::kInvalidArgument, "sphere_cast: direction " + vec_text(ray.direction) + " has no length");
+  if (s.ok() && !(ray.max_distance >= 0.0))
+    s = Status(ErrorCode::kInvalidArgument, "sphere_cast: max_distance must be >= 0");
+  if (s.ok()) s = check_positive("sphere_cast: radius", radius);
+  if (!s.ok()) return s;
+  const double h = world_->lattice().cell_size;
+  const glm::dvec3 dir = glm::normalize(ray.direction);
+  const glm::dvec3 o = world_->lattice().to_lattice(ray.origin);
+  const double r = radius / h, t_max = ray.max_distance / h;
+  // Conservative advancement: the sphere moves by its gap to the nearest surface.
+  const double search = r + 4.0;
+  RayHit hit;
+  double t = 0.0;
+  for (int step = 0; step < kMaxCastSteps; ++step) {
+    const glm::dvec3 x = o + t * dir;
+    const bool inside = inside_solid(*this, x);
+    Nearest n = nearest_surface(*this, x, search);
+    const double dist = n.found ? std::sqrt(n.distance2) : search;
+    if (inside || dist <= r + kContactGap) {
+      hit.hit = true;
+      hit.started_inside = t == 0.0;
+      hit.distance = t * h;
+      hit.material = n.material;
+      if (hit.started_inside) {
+        hit.normal = glm::vec3(-dir);
+        hit.point = ray.origin;
+      } else {
+        hit.point = world_->lattice().to_world(n.found ? n.point : x);
+        hit.normal = glm::vec3(n.found && dist > 1e-6 ? (x - n.point) / dist : -dir);
+      }
+      return hit;
+    }
+    if (t >= t_max) break;
+    t = std::min(t_max, t + std::max(dist - r, kContactGap));
+  }
+  return hit;
 }
 
 }  // namespace ldc

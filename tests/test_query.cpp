@@ -147,5 +147,268 @@ TEST(RayCast, HitsLieOnTheContouredSurface) {
   }
 }
 
+
+Primitive box_primitive(const glm::dvec3& half_extents) {
+  Primitive p;
+  p.shape = Primitive::Shape::kBox;
+  p.half_extents = half_extents;
+  return p;
+}
+
+TEST(RayCast, AlongALatticeLineReturnsTheStoredCrossing) {
+  const glm::dvec3 centre(0.013, 0.021, -0.017);
+  World world = build_primitive(sphere(1.0, centre), 0.1);
+  Queries queries(world);
+  const glm::dvec3 c = glm::round(world.lattice().to_lattice(centre));
+  for (glm::ivec2 uv : {glm::ivec2(0, 0), glm::ivec2(3, -4), glm::ivec2(-6, 2)}) {
+    uv += glm::ivec2(int(c.y), int(c.z));
+    const std::vector<SurfacePoint> points = world.ray_points(0, uv);
+    ASSERT_EQ(points.size(), 2u);
+    const glm::dvec3 start = world.lattice().to_world(glm::dvec3(c.x - 20.0, uv.x, uv.y));
+    RayHit hit = queries.ray_cast({start, glm::dvec3(1, 0, 0)}).value();
+    ASSERT_TRUE(hit.hit);
+    EXPECT_DOUBLE_EQ(hit.distance, (points[0].depth - (c.x - 20.0)) * world.lattice().cell_size);
+    EXPECT_EQ(hit.normal, points[0].normal);
+    // Backwards from the far side: the exit point.
+    const glm::dvec3 far = world.lattice().to_world(glm::dvec3(c.x + 20.0, uv.x, uv.y));
+    hit = queries.ray_cast({far, glm::dvec3(-1, 0, 0)}).value();
+    ASSERT_TRUE(hit.hit);
+    EXPECT_DOUBLE_EQ(hit.distance, (c.x + 20.0 - points[1].depth) * world.lattice().cell_size);
+    EXPECT_EQ(hit.normal, points[1].normal);
+  }
+}
+
+TEST(RayCast, StartingInsideHitsAtDistanceZero) {
+  World world = build_primitive(sphere(1.0, glm::dvec3(0.0)), 0.1);
+  Queries queries(world);
+  for (const glm::dvec3 o : {glm::dvec3(0.01, 0.02, 0.03), glm::dvec3(0.0), glm::dvec3(0.5, -0.3, 0.6)}) {
+    RayHit hit = queries.ray_cast({o, glm::dvec3(0.3, 0.4, 0.5)}).value();
+    EXPECT_TRUE(hit.hit && hit.started_inside);
+    EXPECT_EQ(hit.distance, 0.0);
+    EXPECT_NEAR(glm::dot(glm::dvec3(hit.normal), glm::normalize(glm::dvec3(0.3, 0.4, 0.5))), -1.0, 1e-6);
+    RayHit sphere_hit = queries.sphere_cast({o, glm::dvec3(0.3, 0.4, 0.5)}, 0.05).value();
+    EXPECT_TRUE(sphere_hit.hit && sphere_hit.started_inside);
+    EXPECT_EQ(sphere_hit.distance, 0.0);
+  }
+}
+
+TEST(RayCast, RejectsBadRaysByName) {
+  World world = build_primitive(sphere(1.0, glm::dvec3(0.0)), 0.2);
+  Queries queries(world);
+  const double nan = std::nan("");
+  struct Bad {
+    Ray ray;
+    const char* says;
+  };
+  for (const Bad& bad : {Bad{{glm::dvec3(nan, 0, 0), glm::dvec3(1, 0, 0)}, "origin"},
+                         Bad{{glm::dvec3(0.0), glm::dvec3(0, nan, 0)}, "direction"},
+                         Bad{{glm::dvec3(0.0), glm::dvec3(0.0)}, "no length"},
+                         Bad{{glm::dvec3(0.0), glm::dvec3(1, 0, 0), -1.0}, "max_distance"},
+                         Bad{{glm::dvec3(0.0), glm::dvec3(1, 0, 0), nan}, "max_distance"}}) {
+    Result<RayHit> hit = queries.ray_cast(bad.ray);
+    ASSERT_FALSE(hit.ok());
+    EXPECT_NE(hit.status().message().find(bad.says), std::string::npos) << hit.status().message();
+    EXPECT_FALSE(queries.sphere_cast(bad.ray, 0.1).ok());
+  }
+  std::vector<Ray> rays(3, Ray{glm::dvec3(0, 0, 5), glm::dvec3(0, 0, -1)});
+  rays[2].direction = glm::dvec3(0.0);
+  std::vector<RayHit> hits(3);
+  hits[0].material = 77;
+  Status s = queries.ray_cast(rays, hits);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("ray 2"), std::string::npos) << s.message();
+  EXPECT_EQ(hits[0].material, 77) << "a refused batch must leave the hits untouched";
+  EXPECT_FALSE(queries.closest_point(glm::dvec3(0.0), 100.0).ok());
+  EXPECT_FALSE(queries.overlap(glm::dvec3(0.0), -1.0).ok());
+  EXPECT_FALSE(queries.overlap(Capsule{glm::dvec3(0.0), glm::dvec3(nan), 0.5}).ok());
+  OrientedBox skew;
+  skew.rotation[0] = glm::dvec3(2, 0, 0);
+  EXPECT_FALSE(queries.overlap(skew).ok());
+}
+
+TEST(RayCast, MaxDistanceStopsShortOfTheSurface) {
+  World world = build_primitive(sphere(1.0, glm::dvec3(0.0)), 0.1);
+  Queries queries(world);
+  const Ray ray{glm::dvec3(0.02, 0.03, 3.0), glm::dvec3(0, 0, -1), 1.9};
+  EXPECT_FALSE(queries.ray_cast(ray).value().hit);
+  Ray longer = ray;
+  longer.max_distance = 2.1;
+  EXPECT_TRUE(queries.ray_cast(longer).value().hit);
+}
+
+TEST(RayCast, GrazingRaysAlongFacesAndThroughLatticeEdges) {
+  // Box faces at +-0.55 sit halfway between lattice planes (h = 0.1).
+  World world = build_primitive(box_primitive(glm::dvec3(0.55)), 0.1);
+  Queries queries(world);
+  for (double z : {0.54, 0.549, 0.551, 0.56}) {
+    RayHit hit = queries.ray_cast({glm::dvec3(-3.0, 0.013, z), glm::dvec3(1, 0, 0)}).value();
+    EXPECT_EQ(hit.hit, z < 0.55) << "z " << z;
+    if (hit.hit) {
+      EXPECT_NEAR(hit.distance, 3.0 - 0.55, 0.01) << "z " << z;
+    }
+  }
+  // Diagonal rays through lattice nodes and edges: every cell corner is a tie in the walk.
+  for (const glm::dvec3 d : {glm::dvec3(1, 1, 0), glm::dvec3(1, 1, 1), glm::dvec3(1, 0, 1)}) {
+    const glm::dvec3 o = -3.0 * d;
+    RayHit hit = queries.ray_cast({o, d}).value();
+    ASSERT_TRUE(hit.hit);
+    const double exact = (3.0 - 0.55) * glm::length(d);
+    EXPECT_NEAR(hit.distance, exact, 0.05 * 0.1 * glm::length(d)) << glm::length(d);
+  }
+}
+
+TEST(RayCast, NeverPassesThroughAThinWall) {
+  // A wall a third of a cell thick, tilted: most cell edges it crosses hold two points.
+  TriangleMesh slab = test::box_mesh(glm::dvec3(-1.0, -1.0, -0.017), glm::dvec3(1.0, 1.0, 0.017));
+  const glm::dmat3 tilt = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.5, glm::dvec3(1, 0.4, 0)));
+  for (glm::dvec3& p : slab.positions) p = tilt * p;
+  GridConfig grid;
+  grid.cell_size = 0.1;
+  World world = build_from_mesh(slab, grid).value();
+  ASSERT_TRUE(test::is_valid(world));
+  Queries queries(world);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.7, 0.7);
+  int missed = 0;
+  for (int i = 0; i < 2000; ++i) {
+    const glm::dvec3 target = tilt * glm::dvec3(u(rng), u(rng), 0.0);
+    const glm::dvec3 o = target + 2.0 * random_unit(rng);
+    RayHit hit = queries.ray_cast({o, target - o}).value();
+    missed += hit.hit ? 0 : 1;
+  }
+  EXPECT_EQ(missed, 0);
+}
+
+TEST(RayCast, BatchEqualsSingleRaysWithAColdCacheOnManyThreads) {
+  World world = build_primitive(sphere(1.0, glm::dvec3(0.02, -0.03, 0.01)), 0.05);
+  std::mt19937 rng(5);
+  std::vector<Ray> rays;
+  for (int i = 0; i < 20000; ++i) rays.push_back({2.0 * random_unit(rng), random_unit(rng)});
+  Queries cold(world);  // every chunk's bits are derived concurrently by the batch
+  std::vector<RayHit> hits(rays.size());
+  ASSERT_TRUE(cold.ray_cast(rays, hits).ok());
+  Queries serial(world);
+  for (size_t i = 0; i < rays.size(); ++i) {
+    RayHit one = serial.ray_cast(rays[i]).value();
+    ASSERT_EQ(one.hit, hits[i].hit) << i;
+    ASSERT_EQ(one.distance, hits[i].distance) << i;
+  }
+  QueryCacheStats stats = cold.cache_stats();
+  EXPECT_GT(stats.chunks_indexed, 0u);
+  EXPECT_EQ(stats.retired, 0u);
+}
+
+TEST(RayCast, SeesEditsWithoutARebuild) {
+  WorldEditor editor(build_primitive(sphere(1.0, glm::dvec3(0.0)), 0.05));
+  Queries queries(editor.world());
+  const Ray ray{glm::dvec3(0.013, 0.021, 3.0), glm::dvec3(0, 0, -1)};
+  const double before = queries.ray_cast(ray).value().distance;
+  EXPECT_NEAR(before, 2.0, 0.01);
+  // Dig a 0.5 m sphere where the ray meets the top: the ray now goes 0.5 m deeper.
+  Result<EditReceipt> dig = editor.apply(Brush::sphere(glm::dvec3(0.0, 0.0, 1.0), 0.5), EditOp::kSubtract);
+  ASSERT_TRUE(dig.ok());
+  const double after = queries.ray_cast(ray).value().distance;
+  EXPECT_NEAR(after, 2.5, 0.01);
+  EXPECT_GT(queries.cache_stats().retired, 0u);
+  queries.refresh();
+  EXPECT_EQ(queries.cache_stats().retired, 0u);
+  EXPECT_NEAR(queries.ray_cast(ray).value().distance, 2.5, 0.01);
+  ASSERT_TRUE(editor.undo(dig.value()).ok());
+  EXPECT_EQ(queries.ray_cast(ray).value().distance, before);
+  // A build that grows the world's box is followed too.
+  ASSERT_TRUE(editor.apply(Brush::sphere(glm::dvec3(0.0, 0.0, 2.4), 0.3), EditOp::kAdd).ok());
+  EXPECT_NEAR(queries.ray_cast(ray).value().distance, 0.3, 0.01);
+  queries.refresh();
+  EXPECT_NEAR(queries.ray_cast(ray).value().distance, 0.3, 0.01);
+}
+
+TEST(SphereCast, ContactDistanceMatchesTheAnalyticAnswer) {
+  const double h = 0.05, radius = 1.0;
+  World world = build_primitive(sphere(radius, glm::dvec3(0.0)), h);
+  Queries queries(world);
+  std::mt19937 rng(9);
+  double worst = 0.0;
+  for (int i = 0; i < 300; ++i) {
+    const double r = 0.05 + 0.3 * (i % 7) / 6.0;
+    const glm::dvec3 o = 2.5 * random_unit(rng), target = 0.8 * random_unit(rng);
+    const glm::dvec3 d = glm::normalize(target - o);
+    RayHit hit = queries.sphere_cast({o, d}, r).value();
+    const double exact = sphere_hit(o, d, glm::dvec3(0.0), radius + r);
+    ASSERT_TRUE(hit.hit);
+    ASSERT_FALSE(hit.started_inside);
+    worst = std::max(worst, std::abs(hit.distance - exact));
+    // The contact lies on the sphere, and the normal points from it to the cast sphere's centre.
+    EXPECT_NEAR(glm::length(hit.point), radius, 0.1 * h);
+    const glm::dvec3 centre = o + hit.distance * d;
+    EXPECT_GT(glm::dot(glm::dvec3(hit.normal), glm::normalize(centre - hit.point)), 0.99);
+  }
+  std::printf("sphere cast: worst contact distance error %.3f h\n", worst / h);
+  EXPECT_LT(worst, 0.2 * h);
+  // A sphere passing beside the solid misses.
+  EXPECT_FALSE(queries.sphere_cast({glm::dvec3(-3, 1.3, 0), glm::dvec3(1, 0, 0)}, 0.25).value().hit);
+  EXPECT_TRUE(queries.sphere_cast({glm::dvec3(-3, 1.2, 0), glm::dvec3(1, 0, 0)}, 0.25).value().hit);
+}
+
+TEST(Overlap, SphereBoxAndCapsuleAgainstABox) {
+  const double h = 0.05;
+  World world = build_primitive(box_primitive(glm::dvec3(1.0)), h);  // top face at z = 1
+  Queries queries(world);
+  // Sphere above the top face, touching by 0.3.
+  Overlap o = queries.overlap(glm::dvec3(0.1, 0.2, 1.2), 0.5).value();
+  EXPECT_TRUE(o.overlaps);
+  EXPECT_NEAR(o.depth, 0.3, 0.1 * h);
+  EXPECT_GT(o.normal.z, 0.99f);
+  // Centre inside: out by the radius plus the centre's depth.
+  o = queries.overlap(glm::dvec3(0.1, 0.2, 0.8), 0.5).value();
+  EXPECT_TRUE(o.overlaps);
+  EXPECT_NEAR(o.depth, 0.7, 0.1 * h);
+  EXPECT_GT(o.normal.z, 0.99f);
+  EXPECT_FALSE(queries.overlap(glm::dvec3(0.1, 0.2, 1.6), 0.5).value().overlaps);
+  // A box rotated about z, sunk 0.2 into the top face.
+  OrientedBox box;
+  box.center = glm::dvec3(0.1, -0.2, 1.3);
+  box.half_extents = glm::dvec3(0.3, 0.2, 0.5);
+  box.rotation = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.6, glm::dvec3(0, 0, 1)));
+  o = queries.overlap(box).value();
+  EXPECT_TRUE(o.overlaps);
+  EXPECT_NEAR(o.depth, 0.2, 0.1 * h);
+  EXPECT_GT(o.normal.z, 0.99f);
+  box.center.z = 1.55;
+  EXPECT_FALSE(queries.overlap(box).value().overlaps);
+  // A lying capsule 0.1 into the top face, and one above it.
+  Capsule capsule{glm::dvec3(-0.4, 0.0, 1.15), glm::dvec3(0.5, 0.1, 1.15), 0.25};
+  o = queries.overlap(capsule).value();
+  EXPECT_TRUE(o.overlaps);
+  EXPECT_NEAR(o.depth, 0.1, 0.1 * h);
+  EXPECT_GT(o.normal.z, 0.99f);
+  capsule.a.z = capsule.b.z = 1.3;
+  EXPECT_FALSE(queries.overlap(capsule).value().overlaps);
+  // A small box wholly inside the solid overlaps.
+  box.center = glm::dvec3(0.0);
+  box.half_extents = glm::dvec3(0.1);
+  EXPECT_TRUE(queries.overlap(box).value().overlaps);
+}
+
+TEST(ClosestPoint, OnASphereLiesOnTheRadialLine) {
+  const double h = 0.05;
+  World world = build_primitive(sphere(1.0, glm::dvec3(0.0)), h);
+  Queries queries(world);
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> radial(0.7, 1.3);
+  double worst = 0.0;
+  for (int i = 0; i < 500; ++i) {
+    const glm::dvec3 dir = random_unit(rng), p = radial(rng) * dir;
+    ClosestPoint cp = queries.closest_point(p, 0.5).value();
+    ASSERT_TRUE(cp.found) << i;
+    EXPECT_EQ(cp.query_inside, glm::length(p) < 1.0) << i;
+    worst = std::max(worst, std::abs(cp.distance - std::abs(glm::length(p) - 1.0)));
+    EXPECT_NEAR(glm::length(cp.point), 1.0, 0.05 * h);
+    EXPECT_GT(glm::dot(glm::dvec3(cp.normal), dir), 0.99);
+  }
+  std::printf("closest point: worst distance error %.3f h\n", worst / h);
+  EXPECT_LT(worst, 0.1 * h);
+  EXPECT_FALSE(queries.closest_point(glm::dvec3(0, 0, 2.0), 0.5).value().found);
+}
+
 }  // namespace
 }  // namespace ldc
