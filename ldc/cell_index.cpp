@@ -19,8 +19,8 @@ glm::ivec3 compose(int axis, int along, int u, int v) {
   return r;
 }
 
-void set_bit(std::vector<uint64_t>& bits, int c, const glm::ivec3& l) {
-  bits[size_t(l.z) * c + l.y] |= uint64_t{1} << l.x;
+void set_bit(CellIndex* index, const glm::ivec3& l) {
+  index->surface[size_t(index->brick_of(l))] |= uint64_t{1} << CellIndex::cell_bit(l);
 }
 
 // Visits the points of every ray of `family` with (u, v) local in [u_lo, u_hi) x [v_lo, v_hi).
@@ -62,47 +62,90 @@ void mark_surface_cells(const World& world, const glm::ivec3& chunk, CellIndex* 
                                 for (int cu = gu - 1; cu <= gu; ++cu)
                                   for (int cv = gv - 1; cv <= gv; ++cv)
                                     if (cu >= 0 && cu < c && cv >= 0 && cv < c)
-                                      set_bit(index->surface, c, compose(a, e, cu, cv));
+                                      set_bit(index, compose(a, e, cu, cv));
                               }
                             });
       }
   }
 }
 
+// The cells whose first corner is inside, from the chunk's own X rays.
 void mark_inside_cells(const Chunk* own, ChunkKind kind, CellIndex* index) {
   const int c = index->size;
   if (!own) {
-    if (kind == ChunkKind::kSolid) std::fill(index->inside.begin(), index->inside.end(), c == 64 ? ~uint64_t{0} : (uint64_t{1} << c) - 1);
+    if (kind == ChunkKind::kSolid) std::fill(index->inside.begin(), index->inside.end(), ~uint64_t{0});
     return;
   }
   const RayFamily& xs = own->axis[0];
   std::span<const PackedPoint> all = xs.all_points();
   uint32_t offset = 0;
-  for (int ray = 0; ray < c * c; ++ray) {
+  for (int ray = 0; ray < c * c; ++ray) {  // X rays: ray = z*C + y
     const uint32_t n = xs.point_count(ray);
-    index->inside[size_t(ray)] = node_word(xs.starts_inside(ray), all.subspan(offset, n), c);
+    const uint64_t word = node_word(xs.starts_inside(ray), all.subspan(offset, n), c);
     offset += n;
+    if (!word) continue;
+    const int y = ray % c, z = ray / c;
+    for (int bx = 0; bx < index->bricks_per_axis; ++bx) {
+      const uint64_t nibble = (word >> (bx << kBrickShift)) & 0xF;
+      if (nibble) index->inside[size_t(index->brick_of({bx << kBrickShift, y, z}))] |= nibble << CellIndex::cell_bit({0, y, z});
+    }
   }
 }
 
-void mark_bricks(CellIndex* index) {
-  const int c = index->size, b = c >> kBrickShift;
-  index->bricks.assign((size_t(b) * b * b + 63) / 64, 0);
-  for (int z = 0; z < c; ++z)
-    for (int y = 0; y < c; ++y) {
-      const uint64_t w = index->surface[size_t(z) * c + y] | index->inside[size_t(z) * c + y];
+// Chebyshev distance, in bricks, from each empty brick to the nearest busy one
+// (plus one), by repeated one-brick dilation of row masks: B <= 16 bricks.
+void mark_empty_radius(CellIndex* index) {
+  const int b = index->bricks_per_axis;
+  std::vector<uint16_t> reach(size_t(b) * b, 0);  // row (bz, by): bit bx within the current distance of a busy brick
+  for (int bz = 0; bz < b; ++bz)
+    for (int by = 0; by < b; ++by)
       for (int bx = 0; bx < b; ++bx) {
-        if (!((w >> (bx << kBrickShift)) & 0xF)) continue;
-        const size_t bit = (size_t(z >> kBrickShift) * b + (y >> kBrickShift)) * b + bx;
-        index->bricks[bit >> 6] |= uint64_t{1} << (bit & 63);
+        const size_t k = (size_t(bz) * b + by) * b + bx;
+        if (index->surface[k] | index->inside[k]) reach[size_t(bz) * b + by] |= uint16_t(1u << bx);
       }
-    }
+  index->empty_radius.assign(size_t(b) * b * b, 0);
+  glm::ivec3 lo(b), hi(0);
+  for (int bz = 0; bz < b; ++bz)
+    for (int by = 0; by < b; ++by)
+      for (int bx = 0; bx < b; ++bx)
+        if ((reach[size_t(bz) * b + by] >> bx) & 1u) {
+          lo = glm::min(lo, glm::ivec3(bx, by, bz));
+          hi = glm::max(hi, glm::ivec3(bx, by, bz) + 1);
+        }
+  index->busy_lo = lo << kBrickShift;
+  index->busy_hi = glm::max(lo, hi) << kBrickShift;
+  std::vector<uint16_t> next(reach.size());
+  const uint16_t row_mask = uint16_t((1u << b) - 1);
+  for (int r = 1; r <= b; ++r) {
+    // Bricks not yet reached get radius r; then grow the reach by one brick.
+    bool any = false;
+    for (int bz = 0; bz < b; ++bz)
+      for (int by = 0; by < b; ++by) {
+        const uint16_t row = reach[size_t(bz) * b + by];
+        for (int bx = 0; bx < b; ++bx) {
+          const size_t k = (size_t(bz) * b + by) * b + bx;
+          if (!((row >> bx) & 1u) && index->empty_radius[k] == 0) index->empty_radius[k] = uint8_t(r), any = true;
+        }
+      }
+    if (!any) break;
+    for (int bz = 0; bz < b; ++bz)
+      for (int by = 0; by < b; ++by) {
+        uint16_t grown = 0;
+        for (int z = std::max(0, bz - 1); z <= std::min(b - 1, bz + 1); ++z)
+          for (int y = std::max(0, by - 1); y <= std::min(b - 1, by + 1); ++y) {
+            const uint16_t row = reach[size_t(z) * b + y];
+            grown |= uint16_t(row | (row << 1) | (row >> 1));
+          }
+        next[size_t(bz) * b + by] = grown & row_mask;
+      }
+    reach.swap(next);
+  }
 }
 
 }  // namespace
 
 size_t CellIndex::memory_bytes() const {
-  return sizeof(CellIndex) + (surface.capacity() + inside.capacity() + bricks.capacity()) * sizeof(uint64_t);
+  return sizeof(CellIndex) + (surface.capacity() + inside.capacity()) * sizeof(uint64_t) + empty_radius.capacity();
 }
 
 bool index_current(const CellIndex& index, const World& world, const glm::ivec3& c) {
@@ -131,11 +174,13 @@ std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3
     index->clear_inside = index->kinds[0] == ChunkKind::kSolid;
     return index;
   }
-  index->surface.assign(size_t(c) * c, 0);
-  index->inside.assign(size_t(c) * c, 0);
+  const int b = c >> kBrickShift;
+  index->bricks_per_axis = b;
+  index->surface.assign(size_t(b) * b * b, 0);
+  index->inside.assign(size_t(b) * b * b, 0);
   mark_surface_cells(world, chunk, index.get());
   mark_inside_cells(index->sources[0], index->kinds[0], index.get());
-  mark_bricks(index.get());
+  mark_empty_radius(index.get());
   return index;
 }
 
@@ -144,7 +189,22 @@ std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3
 
 namespace {
 
-// Adds the points on the edge from `node` along `axis` to the planes.
+// Adds the points of one ray, starting at all_points()[first], whose depth
+// steps lie in [lo, hi): the crossings of the edge from `node` along `axis`.
+void add_edge_points(const RayFamily& family, uint32_t first, uint32_t count, uint32_t lo, uint32_t hi,
+                     const glm::dvec3& node_local, int axis, double depth_origin, CellSurface* out) {
+  const PackedPoint* p = family.all_points().data() + first;
+  for (uint32_t i = 0; i < count && p[i].depth < hi; ++i) {
+    if (p[i].depth < lo || out->count == CellSurface::kMaxPlanes) continue;
+    CellPlane& plane = out->planes[size_t(out->count++)];
+    plane.p = node_local;
+    plane.p[axis] = depth_origin + double(p[i].depth - lo) * out->inv_steps;
+    plane.n = glm::dvec3(decode_normal(p[i].normal));
+    plane.material = p[i].material;
+  }
+}
+
+// The general case: the edge's ray may belong to a neighbouring chunk.
 void gather_edge(const World& world, const glm::ivec3& node, int axis, const glm::ivec3& cell, CellSurface* out) {
   const int c = world.chunk_size();
   const glm::ivec3 ch(floor_div(node.x, c), floor_div(node.y, c), floor_div(node.z, c));
@@ -155,16 +215,30 @@ void gather_edge(const World& world, const glm::ivec3& node, int axis, const glm
   const uint32_t n = family.point_count(ray);
   if (!n) return;
   const uint32_t q = depth_steps_per_cell(c);
-  const int segment_start = ch[axis] * c;
-  const uint32_t lo = uint32_t(node[axis] - segment_start) * q, hi = lo + q;
-  const PackedPoint* p = family.all_points().data() + family.first_point(ray);
-  for (uint32_t i = 0; i < n && p[i].depth < hi; ++i) {
-    if (p[i].depth < lo || out->count == CellSurface::kMaxPlanes) continue;
-    CellPlane& plane = out->planes[size_t(out->count++)];
-    plane.p = glm::dvec3(node - cell);
-    plane.p[axis] = double(segment_start - cell[axis]) + double(p[i].depth) / q;
-    plane.n = glm::dvec3(decode_normal(p[i].normal));
-    plane.material = p[i].material;
+  const uint32_t lo = uint32_t(node[axis] - ch[axis] * c) * q;
+  add_edge_points(family, family.first_point(ray), n, lo, lo + q, glm::dvec3(node - cell), axis, 0.0, out);
+}
+
+// The common case: all twelve edges lie in the cell's own chunk, so the four
+// rays of each axis are neighbours in one family (ray, ray+1, ray+C, ray+C+1).
+void gather_inner_cell(const Chunk& chunk, int c, const glm::ivec3& local, CellSurface* out) {
+  const uint32_t q = depth_steps_per_cell(c);
+  for (int a = 0; a < 3; ++a) {
+    const RayFamily& family = chunk.axis[a];
+    if (family.is_uniform()) continue;
+    const int au = axis_u(a), av = axis_v(a);
+    const uint32_t lo = uint32_t(local[a]) * q;
+    for (int dv = 0; dv <= 1; ++dv) {
+      const int ray0 = (local[av] + dv) * c + local[au];
+      const uint32_t n0 = family.point_count(ray0), n1 = family.point_count(ray0 + 1);
+      if (!n0 && !n1) continue;
+      const uint32_t first = family.first_point(ray0);
+      glm::dvec3 node(0.0);
+      node[av] = dv;
+      if (n0) add_edge_points(family, first, n0, lo, lo + q, node, a, 0.0, out);
+      node[au] = 1.0;
+      if (n1) add_edge_points(family, first + n0, n1, lo, lo + q, node, a, 0.0, out);
+    }
   }
 }
 
@@ -210,14 +284,22 @@ void classify(CellSurface* s) {
 
 bool gather_cell_surface(const World& world, const glm::ivec3& cell, CellSurface* out) {
   out->count = 0;
-  for (int a = 0; a < 3; ++a)
-    for (int du = 0; du <= 1; ++du)
-      for (int dv = 0; dv <= 1; ++dv) {
-        glm::ivec3 node = cell;
-        node[axis_u(a)] += du;
-        node[axis_v(a)] += dv;
-        gather_edge(world, node, a, cell, out);
-      }
+  const int c = world.chunk_size();
+  out->inv_steps = 1.0 / depth_steps_per_cell(c);
+  const glm::ivec3 ch(floor_div(cell.x, c), floor_div(cell.y, c), floor_div(cell.z, c));
+  const glm::ivec3 local = cell - ch * c;
+  if (glm::all(glm::lessThan(local, glm::ivec3(c - 1)))) {
+    if (const Chunk* data = world.chunk(ch)) gather_inner_cell(*data, c, local, out);
+  } else {
+    for (int a = 0; a < 3; ++a)
+      for (int du = 0; du <= 1; ++du)
+        for (int dv = 0; dv <= 1; ++dv) {
+          glm::ivec3 node = cell;
+          node[axis_u(a)] += du;
+          node[axis_v(a)] += dv;
+          gather_edge(world, node, a, cell, out);
+        }
+  }
   if (out->count == 0) return false;
   classify(out);
   return true;

@@ -5,6 +5,7 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 #include "ldc/detail/ray_math.h"
@@ -43,8 +44,19 @@ uint32_t RayFamily::first_point(int ray) const {
   if (is_uniform()) return 0;
   if (!first_.empty()) return first_[size_t(ray)];
   const int row = ray / size_;
+  // Sum the counts before the ray in its row, eight bytes at a time.
+  const uint8_t* p = counts_.data() + size_t(row) * size_;
+  const int n = ray - row * size_;
   uint32_t begin = row_first_[size_t(row)];
-  for (int r = row * size_; r < ray; ++r) begin += counts_[size_t(r)];
+  int i = 0;
+  for (; i + 8 <= n; i += 8) {
+    uint64_t w;
+    std::memcpy(&w, p + i, 8);
+    w = (w & 0x00FF00FF00FF00FFull) + ((w >> 8) & 0x00FF00FF00FF00FFull);
+    w = (w & 0x0000FFFF0000FFFFull) + ((w >> 16) & 0x0000FFFF0000FFFFull);
+    begin += uint32_t(w & 0xFFFFFFFFu) + uint32_t(w >> 32);
+  }
+  for (; i < n; ++i) begin += p[i];
   return begin;
 }
 

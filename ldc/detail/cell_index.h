@@ -38,20 +38,26 @@ struct CellIndex {
   std::atomic<uint64_t> checked_stamp{0};  // world stamp at which the sources were last current
 
   int size = 0;               // C
+  int bricks_per_axis = 0;    // B = C / 4
   bool clear = false;         // no surface cell: every cell is inside (clear_inside) or outside
   bool clear_inside = false;
-  std::vector<uint64_t> surface;  // word z*C + y, bit x: the cell has points on an edge
-  std::vector<uint64_t> inside;   // same layout: the cell's first corner is inside
-  std::vector<uint64_t> bricks;   // bit per brick (bz*B + by)*B + bx: not wholly outside
+  // One 64-bit word per 4^3 brick (brick (bz*B + by)*B + bx), bit
+  // ((z&3)*4 + (y&3))*4 + (x&3) per cell.
+  std::vector<uint64_t> surface;  // the cell has points on an edge
+  std::vector<uint64_t> inside;   // the cell's first corner is inside
+  // Per brick without surface or inside cells: r >= 1 such that every brick
+  // within Chebyshev distance r - 1 in this chunk is so too. 0 for the others.
+  std::vector<uint8_t> empty_radius;
+  // Local cells [busy_lo, busy_hi) hold every surface and inside cell (brick-aligned).
+  glm::ivec3 busy_lo{0}, busy_hi{0};
 
-  bool is_surface(const glm::ivec3& l) const { return (surface[size_t(l.z) * size + l.y] >> l.x) & 1u; }
-  bool is_inside(const glm::ivec3& l) const { return (inside[size_t(l.z) * size + l.y] >> l.x) & 1u; }
-  bool brick_busy(const glm::ivec3& l) const {
-    const int b = size >> kBrickShift;
-    const glm::ivec3 k = l >> kBrickShift;
-    const size_t bit = (size_t(k.z) * b + k.y) * b + k.x;
-    return (bricks[bit >> 6] >> (bit & 63)) & 1u;
+  static int cell_bit(const glm::ivec3& l) { return (((l.z & 3) << 2 | (l.y & 3)) << 2) | (l.x & 3); }
+  int brick_of(const glm::ivec3& l) const {
+    return ((l.z >> kBrickShift) * bricks_per_axis + (l.y >> kBrickShift)) * bricks_per_axis + (l.x >> kBrickShift);
   }
+  bool is_surface(const glm::ivec3& l) const { return (surface[size_t(brick_of(l))] >> cell_bit(l)) & 1u; }
+  bool is_inside(const glm::ivec3& l) const { return (inside[size_t(brick_of(l))] >> cell_bit(l)) & 1u; }
+  bool brick_busy(const glm::ivec3& l) const { return empty_radius[size_t(brick_of(l))] == 0; }
   size_t memory_bytes() const;
 };
 
@@ -60,10 +66,12 @@ bool index_current(const CellIndex& index, const World& world, const glm::ivec3&
 std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3& c);
 
 // One tangent plane: a surface point (cell-local coordinates, cells) and its normal.
+// Left uninitialized on purpose: a CellSurface is made per query, and only
+// its first `count` planes are ever read.
 struct CellPlane {
-  glm::dvec3 p{0.0};
-  glm::dvec3 n{0.0};
-  uint16_t material = 0;
+  glm::dvec3 p;
+  glm::dvec3 n;
+  uint16_t material;
 };
 
 enum class CellShape : uint8_t {
@@ -78,6 +86,7 @@ struct CellSurface {
   std::array<CellPlane, kMaxPlanes> planes;
   int count = 0;
   CellShape shape = CellShape::kConvex;
+  double inv_steps = 0.0;  // cells per depth step
 
   // Signed distance-like value: <= 0 inside the solid model [Units: cells].
   double inside_value(const glm::dvec3& x, int* plane = nullptr) const;
