@@ -138,7 +138,10 @@ class Queries {
   Result<RayHit> sphere_cast(const Ray& ray, double radius) const;
 
   // Overlap of a shape with the solid: whether it touches or is inside, how
-  // deep it is (to within 0.1 h), and the normal of the deepest contact.
+  // deep it is (to within 0.1 h), and the normal of the deepest contact. A
+  // sphere whose centre lies more than radius + 16 h below the surface reports
+  // that much as its depth, with the normal +z: the surface is not searched
+  // further. A box or capsule wholly inside the solid overlaps with depth 0.
   Result<Overlap> overlap(const glm::dvec3& center, double radius) const;  // sphere
   Result<Overlap> overlap(const OrientedBox& box) const;
   Result<Overlap> overlap(const Capsule& capsule) const;

@@ -1,6 +1,7 @@
 // Queries: closest points, overlaps and sphere casts, all read from the same
 // per-cell tangent-plane solids as ray casts (detail/cell_index.h).
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -16,6 +17,7 @@ using detail::CellIndex;
 using detail::CellSurface;
 
 constexpr double kMaxSearchCells = 64.0;  // closest_point's search limit
+constexpr double kDeepCells = 16.0;       // overlap: how far below the surface depth is measured
 constexpr double kContactGap = 0.01;      // cells: a sphere this close touches
 constexpr int kMaxCastSteps = 4096;
 
@@ -57,8 +59,17 @@ glm::ivec3 chunk_of(const glm::ivec3& cell, int c) {
   return {detail::floor_div(cell.x, c), detail::floor_div(cell.y, c), detail::floor_div(cell.z, c)};
 }
 
-// Calls fn(cell, index) for every surface cell in [lo, hi] (inclusive), chunk
-// by chunk, skipping chunks and bricks without surface.
+// Bits of a 4^3 brick's word whose cells lie in [lo, hi] (brick-local, inclusive).
+uint64_t brick_range_mask(const glm::ivec3& lo, const glm::ivec3& hi) {
+  const uint64_t row = ((uint64_t{1} << (hi.x + 1)) - 1) & ~((uint64_t{1} << lo.x) - 1);
+  uint64_t mask = 0;
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y) mask |= row << (((z << 2) | y) << 2);
+  return mask;
+}
+
+// Calls fn(cell) for every surface cell in [lo, hi] (inclusive), chunk by
+// chunk and brick by brick, skipping chunks and bricks without surface.
 template <class Fn>
 void for_surface_cells(const Queries& q, const glm::ivec3& lo, const glm::ivec3& hi, Fn&& fn) {
   const int c = q.world().chunk_size();
@@ -72,38 +83,55 @@ void for_surface_cells(const Queries& q, const glm::ivec3& lo, const glm::ivec3&
         const glm::ivec3 k(kx, ky, kz);
         const CellIndex* index = q.cell_index(k);
         if (index->clear) continue;
-        const glm::ivec3 a = glm::max(clo, k * c), b = glm::min(chi, k * c + (c - 1));
-        for (int z = a.z; z <= b.z; ++z)
-          for (int y = a.y; y <= b.y; ++y)
-            for (int x = a.x; x <= b.x; ++x) {
-              const glm::ivec3 l = glm::ivec3(x, y, z) - k * c;
-              if (!index->brick_busy(l)) {
-                x |= (1 << detail::kBrickShift) - 1;  // skip the rest of the brick's row
-                continue;
+        // Local cell range in this chunk, then brick range.
+        const glm::ivec3 a = glm::max(clo - k * c, glm::ivec3(0)), b = glm::min(chi - k * c, glm::ivec3(c - 1));
+        const glm::ivec3 ba = a >> detail::kBrickShift, bb = b >> detail::kBrickShift;
+        for (int bz = ba.z; bz <= bb.z; ++bz)
+          for (int by = ba.y; by <= bb.y; ++by)
+            for (int bx = ba.x; bx <= bb.x; ++bx) {
+              const glm::ivec3 brick(bx, by, bz), first = brick << detail::kBrickShift;
+              uint64_t w = index->surface[size_t(index->brick_of(first))];
+              if (!w) continue;
+              w &= brick_range_mask(glm::max(a - first, glm::ivec3(0)), glm::min(b - first, glm::ivec3(3)));
+              while (w) {
+                const int bit = std::countr_zero(w);
+                w &= w - 1;
+                fn(k * c + first + glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4));
               }
-              if (index->is_surface(l)) fn(glm::ivec3(x, y, z));
             }
       }
 }
 
-// Nearest surface point to x within `radius` cells, searching outwards.
+// Nearest surface point to x within `radius` cells, searching outwards in
+// boxes of doubling reach; within a box, cells nearest first, so that the
+// best point found soon rules out the rest without reading them.
 Nearest nearest_surface(const Queries& q, const glm::dvec3& x, double radius) {
   Nearest best;
   CellSurface surface;
-  double reach = std::min(2.0, radius);
+  std::vector<std::pair<double, glm::ivec3>> candidates;
+  double reach = std::min(2.0, radius), searched = -1.0;
   for (;;) {
     const glm::ivec3 lo(glm::floor(x - reach)), hi(glm::floor(x + reach));
+    candidates.clear();
     for_surface_cells(q, lo, hi, [&](const glm::ivec3& cell) {
       const glm::dvec3 cell_lo(cell);
-      if (best.found && box_distance2(x, cell_lo, cell_lo + 1.0) >= best.distance2) return;
-      if (!detail::gather_cell_surface(q.world(), cell, &surface)) return;
+      const double d2 = box_distance2(x, cell_lo, cell_lo + 1.0);
+      if (d2 > searched * searched || searched < 0.0) candidates.emplace_back(d2, cell);  // not read before
+    });
+    std::sort(candidates.begin(), candidates.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [d2, cell] : candidates) {
+      if (best.found && d2 >= best.distance2) break;
+      if (!detail::gather_cell_surface(q.world(), cell, &surface)) continue;
+      const glm::dvec3 cell_lo(cell);
       detail::CellClosest cc;
-      if (!detail::closest_in_cell(surface, x - cell_lo, &cc)) return;
-      if (best.found && cc.distance2 >= best.distance2) return;
+      if (!detail::closest_in_cell(surface, x - cell_lo, &cc)) continue;
+      if (best.found && cc.distance2 >= best.distance2) continue;
       const detail::CellPlane& plane = surface.planes[size_t(cc.plane)];
       best = Nearest{true, cell_lo + cc.point, plane.n, plane.material, cc.distance2};
-    });
+    }
     if ((best.found && best.distance2 <= reach * reach) || reach >= radius) break;
+    searched = reach;
     reach = std::min(2.0 * reach, radius);
   }
   if (best.found && best.distance2 > radius * radius) best.found = false;
@@ -244,12 +272,12 @@ Result<Overlap> Queries::overlap(const glm::dvec3& center, double radius) const 
   const double r = radius / h;
   const bool inside = inside_solid(*this, x);
   // Inside, the sphere must move out by its radius past the nearest surface.
-  Nearest n = nearest_surface(*this, x, inside ? kMaxSearchCells : r);
+  Nearest n = nearest_surface(*this, x, inside ? r + kDeepCells : r);
   Overlap out;
   if (!inside && !n.found) return out;
   out.overlaps = true;
   if (!n.found) {  // deep inside: at least this deep
-    out.depth = (r + kMaxSearchCells) * h;
+    out.depth = (r + r + kDeepCells) * h;
     out.normal = glm::vec3(0.0f, 0.0f, 1.0f);
     out.point = center;
     return out;
@@ -305,7 +333,8 @@ Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
   const glm::dvec3 dir = glm::normalize(ray.direction);
   const glm::dvec3 o = world_->lattice().to_lattice(ray.origin);
   const double r = radius / h, t_max = ray.max_distance / h;
-  // Conservative advancement: the sphere moves by its gap to the nearest surface.
+  // Conservative advancement: the sphere moves by its gap to the nearest
+  // surface (by the search reach where none is near).
   const double search = r + 4.0;
   RayHit hit;
   double t = 0.0;
