@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <sstream>
+#include <type_traits>
 
 #include "ldc/detail/cell_index.h"
 #include "ldc/detail/ray_math.h"
@@ -96,10 +97,22 @@ void for_surface_cells(const Queries& q, const glm::ivec3& lo, const glm::ivec3&
               while (w) {
                 const int bit = std::countr_zero(w);
                 w &= w - 1;
-                fn(k * c + first + glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4));
+                if constexpr (std::is_same_v<decltype(fn(glm::ivec3())), bool>) {
+                  if (fn(k * c + first + glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4))) return;
+                } else {
+                  fn(k * c + first + glm::ivec3(bit & 3, (bit >> 2) & 3, bit >> 4));
+                }
               }
             }
       }
+}
+
+// Whether any surface cell lies within Chebyshev distance `reach` of x.
+bool any_surface_near(const Queries& q, const glm::dvec3& x, double reach) {
+  bool any = false;
+  for_surface_cells(q, glm::ivec3(glm::floor(x - reach)), glm::ivec3(glm::floor(x + reach)),
+                    [&](const glm::ivec3&) { return any = true; });
+  return any;
 }
 
 // Nearest surface point to x within `radius` cells, searching outwards in
@@ -340,6 +353,22 @@ Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
   double t = 0.0;
   for (int step = 0; step < kMaxCastSteps; ++step) {
     const glm::dvec3 x = o + t * dir;
+    // Open space: move by the widest empty box around the sphere (up to 32 cells).
+    if (!any_surface_near(*this, x, search)) {
+      if (inside_solid(*this, x)) {
+        hit.hit = true;
+        hit.started_inside = t == 0.0;
+        hit.distance = t * h;
+        hit.point = hit.started_inside ? ray.origin : world_->lattice().to_world(x);
+        hit.normal = glm::vec3(-dir);
+        return hit;
+      }
+      double free = search;
+      while (free < r + 32.0 && !any_surface_near(*this, x, 2.0 * free)) free *= 2.0;
+      if (t >= t_max) break;
+      t = std::min(t_max, t + free - r);
+      continue;
+    }
     const bool inside = inside_solid(*this, x);
     Nearest n = nearest_surface(*this, x, search);
     const double dist = n.found ? std::sqrt(n.distance2) : search;
