@@ -32,6 +32,10 @@ mkdir -p docs
   echo "## Game edits on the default landscape (issue 4)"
   echo
   ./build/bench/bench_csg_game
+  echo
+  echo "## Game queries against Embree (issue 5)"
+  echo
+  ./build/bench/bench_query
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"
