@@ -73,5 +73,7 @@ void add_terrain_command(CLI::App& app, CommonOptions& common);
 void add_contour_commands(CLI::App& app, CommonOptions& common);
 void add_boolean_command(CLI::App& app, CommonOptions& common);
 void add_edit_command(CLI::App& app, CommonOptions& common);
+void add_raycast_command(CLI::App& app, CommonOptions& common);
+void add_render_command(CLI::App& app, CommonOptions& common);
 
 }  // namespace ldc::tool

@@ -20,6 +20,8 @@ int main(int argc, char** argv) {
   ldc::tool::add_contour_commands(app, common);
   ldc::tool::add_boolean_command(app, common);
   ldc::tool::add_edit_command(app, common);
+  ldc::tool::add_raycast_command(app, common);
+  ldc::tool::add_render_command(app, common);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
