@@ -364,9 +364,9 @@ Status draw_overlay(const Queries& queries, const Camera& cam, const Overlay& ov
   if (!s.ok()) return s;
 
   const Rgb path_colour(1.0f, 0.84f, 0.10f), point_colour(0.95f, 0.15f, 0.45f), outline(0.05f, 0.05f, 0.05f);
-  Layer hidden_path(glm::mix(path_colour, Rgb(0.9f), 0.3f), 0.55f, img), path_outline(outline, 0.75f, img),
+  Layer hidden_path(glm::mix(path_colour, Rgb(0.9f), 0.3f), 0.7f, img), path_outline(outline, 0.75f, img),
       path_fill(path_colour, 1.0f, img);
-  Layer hidden_dots(glm::mix(point_colour, Rgb(0.9f), 0.3f), 0.55f, img), dot_outline(outline, 0.8f, img),
+  Layer hidden_dots(glm::mix(point_colour, Rgb(0.9f), 0.3f), 0.7f, img), dot_outline(outline, 0.8f, img),
       dot_fill(point_colour, 1.0f, img);
   for (const Sample& p : line) {
     if (p.hidden) {
