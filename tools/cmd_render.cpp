@@ -5,8 +5,10 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <memory>
 #include <sstream>
+#include <tuple>
 #include <vector>
 
 #include <stb_image_write.h>  // the implementation is in libstb (PkgConfig::STB), as stb_image's for the core
@@ -242,38 +244,48 @@ Result<Overlay> read_overlay(const std::string& path) {
   return overlay;
 }
 
-// Coverage of one colour over the image, drawn as the maximum of discs so that
-// overlapping discs do not darken a translucent layer; composited once.
-struct Layer {
-  Rgb colour;
-  float opacity;
-  std::vector<float> coverage;
+// Coverage of one colour, drawn as the maximum of discs so that overlapping
+// discs do not darken a translucent layer, then composited. One buffer (one
+// byte a pixel) serves every layer in turn; only the box drawn on is visited.
+class Layer {
+ public:
+  explicit Layer(const Image& img) : img_(img), coverage_(size_t(img.width) * size_t(img.height), 0) {}
 
-  Layer(const Rgb& c, float o, const Image& img) : colour(c), opacity(o), coverage(size_t(img.width) * size_t(img.height), 0.0f) {}
-
-  void disc(const Image& img, const glm::dvec2& centre, double radius) {
+  void disc(const glm::dvec2& centre, double radius) {
     const int x0 = std::max(0, int(std::floor(centre.x - radius - 1.0)));
-    const int x1 = std::min(img.width - 1, int(std::ceil(centre.x + radius + 1.0)));
+    const int x1 = std::min(img_.width - 1, int(std::ceil(centre.x + radius + 1.0)));
     const int y0 = std::max(0, int(std::floor(centre.y - radius - 1.0)));
-    const int y1 = std::min(img.height - 1, int(std::ceil(centre.y + radius + 1.0)));
+    const int y1 = std::min(img_.height - 1, int(std::ceil(centre.y + radius + 1.0)));
+    if (x0 > x1 || y0 > y1) return;
+    lo_ = glm::min(lo_, glm::ivec2(x0, y0));
+    hi_ = glm::max(hi_, glm::ivec2(x1, y1));
     for (int y = y0; y <= y1; ++y) {
       for (int x = x0; x <= x1; ++x) {
         const double d = glm::length(glm::dvec2(x + 0.5, y + 0.5) - centre);
-        const float c = float(std::clamp(radius + 0.5 - d, 0.0, 1.0));
-        float& cov = coverage[size_t(y) * size_t(img.width) + size_t(x)];
+        const auto c = uint8_t(std::lround(255.0 * std::clamp(radius + 0.5 - d, 0.0, 1.0)));
+        uint8_t& cov = coverage_[size_t(y) * size_t(img_.width) + size_t(x)];
         cov = std::max(cov, c);
       }
     }
   }
 
-  void composite(Image& img) const {
-    for (int y = 0; y < img.height; ++y) {
-      for (int x = 0; x < img.width; ++x) {
-        const float a = opacity * coverage[size_t(y) * size_t(img.width) + size_t(x)];
-        if (a > 0.0f) img.set(x, y, glm::mix(img.get(x, y), colour, a));
+  // Blends `colour` over the image by coverage x opacity and clears the buffer.
+  void composite(Image& img, const Rgb& colour, float opacity) {
+    for (int y = lo_.y; y <= hi_.y; ++y) {
+      for (int x = lo_.x; x <= hi_.x; ++x) {
+        uint8_t& cov = coverage_[size_t(y) * size_t(img.width) + size_t(x)];
+        if (cov) img.set(x, y, glm::mix(img.get(x, y), colour, opacity * float(cov) / 255.0f));
+        cov = 0;
       }
     }
+    lo_ = glm::ivec2(std::numeric_limits<int>::max());
+    hi_ = glm::ivec2(-1);
   }
+
+ private:
+  const Image& img_;
+  std::vector<uint8_t> coverage_;
+  glm::ivec2 lo_{std::numeric_limits<int>::max()}, hi_{-1};
 };
 
 // A point of the overlay as drawn: where it lands and whether the solid hides it.
@@ -364,29 +376,26 @@ Status draw_overlay(const Queries& queries, const Camera& cam, const Overlay& ov
   if (!s.ok()) return s;
 
   const Rgb path_colour(1.0f, 0.84f, 0.10f), point_colour(0.95f, 0.15f, 0.45f), outline(0.05f, 0.05f, 0.05f);
-  Layer hidden_path(glm::mix(path_colour, Rgb(0.9f), 0.3f), 0.7f, img), path_outline(outline, 0.75f, img),
-      path_fill(path_colour, 1.0f, img);
-  Layer hidden_dots(glm::mix(point_colour, Rgb(0.9f), 0.3f), 0.7f, img), dot_outline(outline, 0.8f, img),
-      dot_fill(point_colour, 1.0f, img);
+  const double R = 2.2 * r;  // dot radius
+  Layer layer(img);
+  // Hidden parts first (dimmed; the path dashed), then what is seen, outlined.
   for (const Sample& p : line) {
-    if (p.hidden) {
-      if (std::fmod(p.along, 6.0 * r) < 3.6 * r) hidden_path.disc(img, p.pixel, 0.75 * r);  // dashed
-    } else {
-      path_outline.disc(img, p.pixel, r + 1.25);
-      path_fill.disc(img, p.pixel, r);
-    }
+    if (p.hidden && std::fmod(p.along, 6.0 * r) < 3.6 * r) layer.disc(p.pixel, 0.75 * r);
   }
-  const double R = 2.2 * r;
+  layer.composite(img, glm::mix(path_colour, Rgb(0.9f), 0.3f), 0.7f);
   for (const Sample& p : dots) {
-    if (p.hidden) {
-      hidden_dots.disc(img, p.pixel, 0.8 * R);
-    } else {
-      dot_outline.disc(img, p.pixel, R + 1.5);
-      dot_fill.disc(img, p.pixel, R);
-    }
+    if (p.hidden) layer.disc(p.pixel, 0.8 * R);
   }
-  for (const Layer* l : {&hidden_path, &hidden_dots, &path_outline, &path_fill, &dot_outline, &dot_fill}) {
-    l->composite(img);
+  layer.composite(img, glm::mix(point_colour, Rgb(0.9f), 0.3f), 0.7f);
+  for (const auto& [samples, radius, colour] : {std::tuple{&line, r, path_colour}, std::tuple{&dots, R, point_colour}}) {
+    for (const Sample& p : *samples) {
+      if (!p.hidden) layer.disc(p.pixel, radius + 1.25);
+    }
+    layer.composite(img, outline, 0.75f);
+    for (const Sample& p : *samples) {
+      if (!p.hidden) layer.disc(p.pixel, radius);
+    }
+    layer.composite(img, colour, 1.0f);
   }
   stats.samples = line.size() + dots.size();
   for (const auto* v : {&line, &dots}) {
