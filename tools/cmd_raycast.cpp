@@ -6,7 +6,6 @@
 #include <sstream>
 #include <vector>
 
-#include <tbb/task_arena.h>
 
 #include "camera.h"
 #include "common.h"
@@ -69,7 +68,9 @@ Status check_ray_fields(const Ray& r, const std::string& where) {
 
 Result<glm::dvec3> json_vec3(const nlohmann::json& v, const std::string& where, const char* field) {
   const std::string what = where + "field '" + field + "' ";
-  if (!v.is_array() || v.size() != 3) return Status(ErrorCode::kParseError, what + "must be an array of three numbers [x, y, z]");
+  if (!v.is_array() || v.size() != 3) {
+    return Status(ErrorCode::kParseError, what + "must be an array of three numbers [x, y, z]");
+  }
   glm::dvec3 out;
   for (int i = 0; i < 3; ++i) {
     if (!v[i].is_number()) {
@@ -243,8 +244,10 @@ bool write_hits(std::FILE* f, const nlohmann::json& summary, const RaySource& sr
     }
     std::fprintf(f, "\"hit\": true, \"distance\": %.10g, \"point\": ", h.distance);
     write_vec3(f, h.point.x, h.point.y, h.point.z);
-    std::fprintf(f, ", \"normal\": [%.7g, %.7g, %.7g], \"material\": %u, \"started_inside\": %s}", double(h.normal.x) + 0.0,
-                 double(h.normal.y) + 0.0, double(h.normal.z) + 0.0, unsigned(h.material), h.started_inside ? "true" : "false");
+    // + 0.0: no "-0" in the output.
+    std::fprintf(f, ", \"normal\": [%.7g, %.7g, %.7g], \"material\": %u, \"started_inside\": %s}",
+                 double(h.normal.x) + 0.0, double(h.normal.y) + 0.0, double(h.normal.z) + 0.0, unsigned(h.material),
+                 h.started_inside ? "true" : "false");
   }
   std::fprintf(f, "%s]}\n", hits.empty() ? "" : "\n");
   return std::ferror(f) == 0;
@@ -257,7 +260,9 @@ void print_summary(std::FILE* f, const nlohmann::json& s, const std::vector<RayH
                s["seconds"].get<double>(), s["mrays_per_s"].get<double>(), s["threads"].get<int>());
   if (s.contains("camera")) {
     const auto& c = s["camera"];
-    auto v = [](const nlohmann::json& a) { return vec3_text({a[0].get<double>(), a[1].get<double>(), a[2].get<double>()}); };
+    auto v = [](const nlohmann::json& a) {
+      return vec3_text({a[0].get<double>(), a[1].get<double>(), a[2].get<double>()});
+    };
     std::fprintf(f, "camera %s -> target %s, fov %g, %d x %d\n", v(c["position"]).c_str(), v(c["target"]).c_str(),
                  c["fov"].get<double>(), c["width"].get<int>(), c["height"].get<int>());
   }
@@ -266,8 +271,8 @@ void print_summary(std::FILE* f, const nlohmann::json& s, const std::vector<RayH
     if (!h.hit) {
       std::fprintf(f, "no hit\n");
     } else {
-      std::fprintf(f, "hit at distance %.6g: point %s, normal %s, material %u%s\n", h.distance, vec3_text(h.point).c_str(),
-                   vec3_text(glm::dvec3(h.normal)).c_str(), unsigned(h.material),
+      std::fprintf(f, "hit at distance %.6g: point %s, normal %s, material %u%s\n", h.distance,
+                   vec3_text(h.point).c_str(), vec3_text(glm::dvec3(h.normal)).c_str(), unsigned(h.material),
                    h.started_inside ? " (started inside the solid)" : "");
     }
   }
@@ -296,7 +301,7 @@ int run_raycast(const RaycastArgs& a, const CommonOptions& common) {
   nlohmann::json summary = {{"rays", hits.size()}, {"hits", n_hits}, {"seconds", seconds},
                             {"mrays_per_s", seconds > 0.0 ? double(hits.size()) / seconds * 1e-6 : 0.0},
                             {"load_seconds", load_seconds}, {"source", src.value().name},
-                            {"threads", tbb::this_task_arena::max_concurrency()}};
+                            {"threads", thread_count()}};
   if (const auto& c = src.value().camera) {
     summary["camera"] = {{"position", {c->position().x, c->position().y, c->position().z}},
                          {"target", {c->target().x, c->target().y, c->target().z}},

@@ -13,7 +13,6 @@
 
 #include <stb_image_write.h>  // the implementation is in libstb (PkgConfig::STB), as stb_image's for the core
 #include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
 
 #include "camera.h"
 #include "common.h"
@@ -387,7 +386,8 @@ Status draw_overlay(const Queries& queries, const Camera& cam, const Overlay& ov
     if (p.hidden) layer.disc(p.pixel, 0.8 * R);
   }
   layer.composite(img, glm::mix(point_colour, Rgb(0.9f), 0.3f), 0.7f);
-  for (const auto& [samples, radius, colour] : {std::tuple{&line, r, path_colour}, std::tuple{&dots, R, point_colour}}) {
+  for (const auto& [samples, radius, colour] :
+       {std::tuple{&line, r, path_colour}, std::tuple{&dots, R, point_colour}}) {
     for (const Sample& p : *samples) {
       if (!p.hidden) layer.disc(p.pixel, radius + 1.25);
     }
@@ -468,8 +468,9 @@ int run_render(const RenderArgs& a, const CommonOptions& common) {
   const double mrays = stats.cast_seconds > 0.0 ? double(cast) / stats.cast_seconds * 1e-6 : 0.0;
   nlohmann::json report = {
       {"ok", true}, {"output", a.output}, {"width", img.width}, {"height", img.height}, {"rays", stats.rays},
-      {"shadow_rays", stats.shadow_rays}, {"hits", stats.hits}, {"hit_fraction", hit_fraction}, {"started_inside", stats.started_inside},
-      {"mrays_per_s", mrays}, {"threads", tbb::this_task_arena::max_concurrency()},
+      {"shadow_rays", stats.shadow_rays}, {"hits", stats.hits}, {"hit_fraction", hit_fraction},
+      {"started_inside", stats.started_inside},
+      {"mrays_per_s", mrays}, {"threads", thread_count()},
       {"camera", {{"position", vec_json(c.position())}, {"target", vec_json(c.target())}, {"fov", c.fov()}}},
       {"seconds", seconds}};
   if (!a.overlay.empty()) {

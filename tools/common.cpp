@@ -139,4 +139,8 @@ void set_thread_count(int threads) {
   }
 }
 
+int thread_count() {
+  return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
+
 }  // namespace ldc::tool

@@ -64,6 +64,8 @@ void print_seconds(const nlohmann::json& seconds);
 
 // Limits the TBB worker threads for the rest of the process (0 = all).
 void set_thread_count(int threads);
+// The worker threads TBB may use now.
+int thread_count();
 
 // Registers the subcommands.
 void add_build_command(CLI::App& app, CommonOptions& common);
