@@ -225,6 +225,12 @@ Result<RayHit> Queries::ray_cast(const Ray& ray) const {
                          hit.distance = ch.t;
                          hit.normal = glm::vec3(plane.n);
                          hit.material = plane.material;
+                         if (glm::dot(plane.n, d) > 0.0) {
+                           // Inside the cell's planes on entry, with the nearest plane facing away
+                           // (a step or thin lip between cells): the face entered is the surface hit.
+                           hit.normal = entry_axis >= 0 ? glm::vec3(0.0f) : glm::vec3(-dir);
+                           if (entry_axis >= 0) hit.normal[entry_axis] = d[entry_axis] > 0.0 ? -1.0f : 1.0f;
+                         }
                          return true;
                        });
     if (hit.hit && hit.distance <= 0.0) hit.started_inside = true;

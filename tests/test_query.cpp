@@ -11,6 +11,7 @@
 #include "csg/csg.h"
 #include "ldc/build.h"
 #include "ldc/query.h"
+#include "ldc/terrain.h"
 #include "test_util.h"
 
 namespace ldc {
@@ -224,6 +225,29 @@ TEST(RayCast, RejectsBadRaysByName) {
   OrientedBox skew;
   skew.rotation[0] = glm::dvec3(2, 0, 0);
   EXPECT_FALSE(queries.overlap(skew).ok());
+}
+
+TEST(RayCast, HitNormalsNeverFaceAwayFromTheRay) {
+  // The default landscape has steps and lips thinner than a cell, where a ray
+  // can enter a cell already inside its planes; found by ldc render.
+  TerrainConfig config;
+  config.size_x = config.size_y = 16.0;
+  World world = build_terrain(config, 0.2).value();
+  Queries queries(world);
+  const WorldBox b = world.solid_bounds().value();
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int hits = 0, away = 0;
+  for (int i = 0; i < 100000; ++i) {
+    const glm::dvec3 o = b.min + (b.max - b.min) * glm::dvec3(u(rng), u(rng), u(rng) + 1.0);
+    const glm::dvec3 d = random_unit(rng);
+    RayHit hit = queries.ray_cast({o, d}).value();
+    if (!hit.hit || hit.started_inside) continue;
+    ++hits;
+    away += glm::dot(glm::dvec3(hit.normal), d) > 0.0 ? 1 : 0;
+  }
+  EXPECT_GT(hits, 5000) << hits;
+  EXPECT_EQ(away, 0);
 }
 
 TEST(RayCast, MaxDistanceStopsShortOfTheSurface) {
