@@ -346,6 +346,38 @@ TEST(RayCast, SeesEditsWithoutARebuild) {
   EXPECT_NEAR(queries.ray_cast(ray).value().distance, 0.3, 0.01);
 }
 
+TEST(RayCast, AfterRandomEditsEqualsAFreshCache) {
+  // Bits derived before each edit (digs, builds that grow the box, with and
+  // without refresh()) must answer exactly as bits derived from scratch.
+  TerrainConfig config;
+  config.size_x = config.size_y = 12.0;
+  WorldEditor editor(build_terrain(config, 0.25).value());
+  Queries warm(editor.world());
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  auto random_rays = [&](int n) {
+    const WorldBox b = editor.world().solid_bounds().value();
+    std::vector<Ray> rays;
+    for (int i = 0; i < n; ++i) rays.push_back({b.min + (b.max - b.min) * glm::dvec3(u(rng), u(rng), u(rng)), random_unit(rng)});
+    return rays;
+  };
+  for (int edit = 0; edit < 12; ++edit) {
+    for (const Ray& ray : random_rays(500)) (void)warm.ray_cast(ray);  // derive bits before the edit
+    const WorldBox b = editor.world().solid_bounds().value();
+    const glm::dvec3 at = b.min + (b.max - b.min) * glm::dvec3(u(rng), u(rng), u(rng));
+    const EditOp op = edit % 3 == 2 ? EditOp::kAdd : EditOp::kSubtract;
+    ASSERT_TRUE(editor.apply(Brush::sphere(at, 0.5 + 2.0 * u(rng), uint16_t(edit)), op).ok());
+    if (edit % 4 == 3) warm.refresh();
+    Queries fresh(editor.world());
+    for (const Ray& ray : random_rays(3000)) {
+      const RayHit a = warm.ray_cast(ray).value(), c = fresh.ray_cast(ray).value();
+      ASSERT_EQ(a.hit, c.hit) << "edit " << edit;
+      ASSERT_EQ(a.distance, c.distance) << "edit " << edit;
+      ASSERT_EQ(a.material, c.material) << "edit " << edit;
+    }
+  }
+}
+
 TEST(SphereCast, ContactDistanceMatchesTheAnalyticAnswer) {
   const double h = 0.05, radius = 1.0;
   World world = build_primitive(sphere(radius, glm::dvec3(0.0)), h);
