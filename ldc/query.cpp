@@ -44,7 +44,6 @@ void Queries::refresh() {
     reset_slots();
     return;
   }
-  const size_t n = size_t(slot_dims_.x) * slot_dims_.y * slot_dims_.z;
   size_t i = 0;
   for (int z = 0; z < slot_dims_.z; ++z)
     for (int y = 0; y < slot_dims_.y; ++y)
@@ -55,7 +54,6 @@ void Queries::refresh() {
           slots_[i].store(nullptr, std::memory_order_relaxed);
         }
       }
-  (void)n;
 }
 
 QueryCacheStats Queries::cache_stats() const {
