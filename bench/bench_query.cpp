@@ -31,6 +31,7 @@
 #include "bench_common.h"
 #include "contour/contour.h"
 #include "csg/csg.h"
+#include "embree/embree_ray.h"
 #include "ldc/build.h"
 #include "ldc/query.h"
 #include "ldc/terrain.h"
@@ -247,21 +248,7 @@ double embree_pass(const EmbreeMesh& m, const std::vector<ldc::Ray>& rays, size_
     rtcInitIntersectContext(&ctx);
     for (size_t i = b; i < e; ++i) {
       const ldc::Ray& ray = rays[i];
-      RTCRayHit rh;
-      rh.ray.org_x = float(ray.origin.x);
-      rh.ray.org_y = float(ray.origin.y);
-      rh.ray.org_z = float(ray.origin.z);
-      rh.ray.dir_x = float(ray.direction.x);
-      rh.ray.dir_y = float(ray.direction.y);
-      rh.ray.dir_z = float(ray.direction.z);
-      rh.ray.tnear = 0.0f;
-      rh.ray.tfar = std::numeric_limits<float>::infinity();
-      rh.ray.time = 0.0f;
-      rh.ray.mask = 0xFFFFFFFFu;
-      rh.ray.id = 0;
-      rh.ray.flags = 0;
-      rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-      rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+      RTCRayHit rh = ldc::test::embree_ray(ray.origin, ray.direction);
       rtcIntersect1(m.scene, &ctx, &rh);
       if (out) {
         Answer& a = (*out)[i];

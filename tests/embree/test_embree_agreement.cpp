@@ -25,6 +25,7 @@
 #include <gtest/gtest.h>
 
 #include "contour/contour.h"
+#include "embree/embree_ray.h"
 #include "ldc/build.h"
 #include "ldc/query.h"
 #include "test_util.h"
@@ -79,21 +80,7 @@ struct EmbreeScene {
   Answer cast(const glm::dvec3& o, const glm::dvec3& d) const {
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRayHit rh;
-    rh.ray.org_x = float(o.x);
-    rh.ray.org_y = float(o.y);
-    rh.ray.org_z = float(o.z);
-    rh.ray.dir_x = float(d.x);
-    rh.ray.dir_y = float(d.y);
-    rh.ray.dir_z = float(d.z);
-    rh.ray.tnear = 0.0f;
-    rh.ray.tfar = std::numeric_limits<float>::infinity();
-    rh.ray.time = 0.0f;
-    rh.ray.mask = 0xFFFFFFFFu;
-    rh.ray.id = 0;
-    rh.ray.flags = 0;
-    rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
-    rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+    RTCRayHit rh = ldc::test::embree_ray(o, d);
     rtcIntersect1(scene, &ctx, &rh);
     Answer a;
     if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return a;
