@@ -26,6 +26,7 @@
 #include <utility>
 
 #include "contour/detail/export.h"
+#include "ldc/detail/vec_text.h"
 
 namespace ldc {
 namespace export_detail {
@@ -148,15 +149,8 @@ namespace {
 
 // ----------------------------------------------------------------- checks
 
-std::string show(const glm::dvec3& p) {
-  char buffer[96];
-  std::snprintf(buffer, sizeof(buffer), "(%g, %g, %g)", p.x, p.y, p.z);
-  return buffer;
-}
-
-bool finite(const glm::dvec3& p) {
-  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-}
+using detail::vec_text;
+using detail::is_finite;
 
 Status invalid(const std::string& path, const std::string& message) {
   return error_at(ErrorCode::kInvalidArgument, path, message);
@@ -184,15 +178,15 @@ Status check_contour_mesh(const ContourMesh& mesh, const std::string& path) {
   Status status = check_array_sizes(mesh, path);
   if (!status.ok()) return status;
   for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    if (!finite(mesh.positions[v])) {
-      return invalid(path, "vertex " + std::to_string(v) + " position " + show(mesh.positions[v]) +
+    if (!is_finite(mesh.positions[v])) {
+      return invalid(path, "vertex " + std::to_string(v) + " position " + vec_text(mesh.positions[v]) +
                                " is not finite");
     }
   }
   for (size_t v = 0; v < mesh.normals.size(); ++v) {
-    if (!finite(glm::dvec3(mesh.normals[v]))) {
+    if (!is_finite(glm::dvec3(mesh.normals[v]))) {
       return invalid(path, "vertex " + std::to_string(v) + " normal " +
-                               show(glm::dvec3(mesh.normals[v])) + " is not finite");
+                               vec_text(glm::dvec3(mesh.normals[v])) + " is not finite");
     }
   }
   for (size_t t = 0; t < mesh.triangle_count(); ++t) {

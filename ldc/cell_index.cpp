@@ -151,7 +151,7 @@ size_t CellIndex::memory_bytes() const {
 bool index_current(const CellIndex& index, const World& world, const glm::ivec3& c) {
   for (int s = 0; s < kIndexSources; ++s) {
     const glm::ivec3 ch = c + kIndexSourceOffsets[size_t(s)];
-    if (world.chunk(ch) != index.sources[size_t(s)] || world.chunk_kind(ch) != index.kinds[size_t(s)]) return false;
+    if (world.chunk(ch) != index.sources[size_t(s)].get() || world.chunk_kind(ch) != index.kinds[size_t(s)]) return false;
   }
   return true;
 }
@@ -164,8 +164,7 @@ std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3
   bool uniform = true;
   for (int s = 0; s < kIndexSources; ++s) {
     const glm::ivec3 ch = chunk + kIndexSourceOffsets[size_t(s)];
-    index->keep[size_t(s)] = world.chunk_shared(ch);
-    index->sources[size_t(s)] = index->keep[size_t(s)].get();
+    index->sources[size_t(s)] = world.chunk_shared(ch);
     index->kinds[size_t(s)] = world.chunk_kind(ch);
     uniform = uniform && index->kinds[size_t(s)] == index->kinds[0] && index->kinds[0] != ChunkKind::kMixed;
   }
@@ -179,7 +178,7 @@ std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3
   index->surface.assign(size_t(b) * b * b, 0);
   index->inside.assign(size_t(b) * b * b, 0);
   mark_surface_cells(world, chunk, index.get());
-  mark_inside_cells(index->sources[0], index->kinds[0], index.get());
+  mark_inside_cells(index->sources[0].get(), index->kinds[0], index.get());
   mark_empty_radius(index.get());
   return index;
 }
@@ -192,13 +191,14 @@ namespace {
 // Adds the points of one ray, starting at all_points()[first], whose depth
 // steps lie in [lo, hi): the crossings of the edge from `node` along `axis`.
 void add_edge_points(const RayFamily& family, uint32_t first, uint32_t count, uint32_t lo, uint32_t hi,
-                     const glm::dvec3& node_local, int axis, double depth_origin, CellSurface* out) {
+                     const glm::dvec3& node_local, int axis, CellSurface* out) {
+  const double cells_per_step = 1.0 / (hi - lo);
   const PackedPoint* p = family.all_points().data() + first;
   for (uint32_t i = 0; i < count && p[i].depth < hi; ++i) {
     if (p[i].depth < lo || out->count == CellSurface::kMaxPlanes) continue;
     CellPlane& plane = out->planes[size_t(out->count++)];
     plane.p = node_local;
-    plane.p[axis] = depth_origin + double(p[i].depth - lo) * out->inv_steps;
+    plane.p[axis] = double(p[i].depth - lo) * cells_per_step;
     plane.n = glm::dvec3(decode_normal(p[i].normal));
     plane.material = p[i].material;
   }
@@ -207,7 +207,7 @@ void add_edge_points(const RayFamily& family, uint32_t first, uint32_t count, ui
 // The general case: the edge's ray may belong to a neighbouring chunk.
 void gather_edge(const World& world, const glm::ivec3& node, int axis, const glm::ivec3& cell, CellSurface* out) {
   const int c = world.chunk_size();
-  const glm::ivec3 ch(floor_div(node.x, c), floor_div(node.y, c), floor_div(node.z, c));
+  const glm::ivec3 ch = world.chunk_of_node(node);
   const Chunk* data = world.chunk(ch);
   if (!data) return;
   const RayFamily& family = data->axis[axis];
@@ -216,7 +216,7 @@ void gather_edge(const World& world, const glm::ivec3& node, int axis, const glm
   if (!n) return;
   const uint32_t q = depth_steps_per_cell(c);
   const uint32_t lo = uint32_t(node[axis] - ch[axis] * c) * q;
-  add_edge_points(family, family.first_point(ray), n, lo, lo + q, glm::dvec3(node - cell), axis, 0.0, out);
+  add_edge_points(family, family.first_point(ray), n, lo, lo + q, glm::dvec3(node - cell), axis, out);
 }
 
 // The common case: all twelve edges lie in the cell's own chunk, so the four
@@ -235,9 +235,9 @@ void gather_inner_cell(const Chunk& chunk, int c, const glm::ivec3& local, CellS
       const uint32_t first = family.first_point(ray0);
       glm::dvec3 node(0.0);
       node[av] = dv;
-      if (n0) add_edge_points(family, first, n0, lo, lo + q, node, a, 0.0, out);
+      if (n0) add_edge_points(family, first, n0, lo, lo + q, node, a, out);
       node[au] = 1.0;
-      if (n1) add_edge_points(family, first + n0, n1, lo, lo + q, node, a, 0.0, out);
+      if (n1) add_edge_points(family, first + n0, n1, lo, lo + q, node, a, out);
     }
   }
 }
@@ -285,8 +285,7 @@ void classify(CellSurface* s) {
 bool gather_cell_surface(const World& world, const glm::ivec3& cell, CellSurface* out) {
   out->count = 0;
   const int c = world.chunk_size();
-  out->inv_steps = 1.0 / depth_steps_per_cell(c);
-  const glm::ivec3 ch(floor_div(cell.x, c), floor_div(cell.y, c), floor_div(cell.z, c));
+  const glm::ivec3 ch = world.chunk_of_node(cell);  // a cell is named by its first node
   const glm::ivec3 local = cell - ch * c;
   if (glm::all(glm::lessThan(local, glm::ivec3(c - 1)))) {
     if (const Chunk* data = world.chunk(ch)) gather_inner_cell(*data, c, local, out);

@@ -11,12 +11,12 @@
 #include <cstring>
 #include <numeric>
 
+#include "ldc/detail/vec_text.h"
+
 namespace ldc {
 namespace {
 
-bool is_finite(const glm::dvec3& p) {
-  return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-}
+using detail::is_finite;
 
 bool indices_valid(const TriangleMesh& mesh, const glm::uvec3& triangle) {
   const size_t count = mesh.positions.size();

@@ -9,6 +9,7 @@
 
 #include "ldc/detail/cell_index.h"
 #include "ldc/detail/ray_math.h"
+#include "ldc/detail/vec_text.h"
 
 namespace ldc {
 
@@ -16,21 +17,21 @@ using detail::CellIndex;
 
 Queries::Queries(const World& world) : world_(&world) { reset_slots(); }
 
-Queries::~Queries() {
+Queries::~Queries() { delete_slots(); }
+
+size_t Queries::slot_count() const { return size_t(slot_dims_.x) * slot_dims_.y * slot_dims_.z; }
+
+void Queries::delete_slots() {
   if (!slots_) return;
-  const size_t n = size_t(slot_dims_.x) * slot_dims_.y * slot_dims_.z;
-  for (size_t i = 0; i < n; ++i) delete slots_[i].load(std::memory_order_relaxed);
+  for (size_t i = 0; i < slot_count(); ++i) delete slots_[i].exchange(nullptr);
 }
 
 void Queries::reset_slots() {
-  if (slots_) {
-    const size_t n = size_t(slot_dims_.x) * slot_dims_.y * slot_dims_.z;
-    for (size_t i = 0; i < n; ++i) delete slots_[i].exchange(nullptr);
-  }
+  delete_slots();
   // One extra layer below the box: those cells touch the box's first nodes.
   slot_origin_ = world_->chunk_origin() - 1;
   slot_dims_ = world_->chunk_dims() + 1;
-  const size_t n = size_t(slot_dims_.x) * slot_dims_.y * slot_dims_.z;
+  const size_t n = slot_count();
   slots_ = std::make_unique<std::atomic<CellIndex*>[]>(n);
   for (size_t i = 0; i < n; ++i) slots_[i].store(nullptr, std::memory_order_relaxed);
 }
@@ -58,8 +59,7 @@ void Queries::refresh() {
 
 QueryCacheStats Queries::cache_stats() const {
   QueryCacheStats stats;
-  const size_t n = size_t(slot_dims_.x) * slot_dims_.y * slot_dims_.z;
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i = 0; i < slot_count(); ++i) {
     const CellIndex* e = slots_[i].load(std::memory_order_acquire);
     if (!e) continue;
     ++stats.chunks_indexed;
@@ -126,28 +126,25 @@ const CellIndex* Queries::lookup_slow(const glm::ivec3& c, std::atomic<CellIndex
 // ---------------------------------------------------------------------------
 // Ray casts
 
-namespace {
-
-Status check_ray(const Ray& ray) {
-  auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  auto text = [](const glm::dvec3& v) {
-    std::ostringstream s;
-    s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
-    return s.str();
-  };
-  if (!finite(ray.origin)) return {ErrorCode::kInvalidArgument, "ray origin " + text(ray.origin) + " is not finite"};
-  if (!finite(ray.direction))
-    return {ErrorCode::kInvalidArgument, "ray direction " + text(ray.direction) + " is not finite"};
+Status detail::check_ray(const Ray& ray, const char* what) {
+  using detail::vec_text;
+  const std::string head = std::string(what) + ": ";
+  if (!detail::is_finite(ray.origin))
+    return {ErrorCode::kInvalidArgument, head + "origin " + vec_text(ray.origin) + " is not finite"};
+  if (!detail::is_finite(ray.direction))
+    return {ErrorCode::kInvalidArgument, head + "direction " + vec_text(ray.direction) + " is not finite"};
   const double len = glm::length(ray.direction);
   if (!(len > 1e-300) || !std::isfinite(len))
-    return {ErrorCode::kInvalidArgument, "ray direction " + text(ray.direction) + " has no length"};
+    return {ErrorCode::kInvalidArgument, head + "direction " + vec_text(ray.direction) + " has no length"};
   if (!(ray.max_distance >= 0.0)) {
     std::ostringstream s;
-    s << "ray max_distance " << ray.max_distance << " must be >= 0";
+    s << head << "max_distance " << ray.max_distance << " must be >= 0";
     return {ErrorCode::kInvalidArgument, s.str()};
   }
   return {};
 }
+
+namespace {
 
 // A ray along a lattice axis whose origin lies on a lattice line: the axis, or -1.
 int lattice_line_axis(const glm::dvec3& o, const glm::dvec3& d) {
@@ -190,8 +187,12 @@ RayHit cast_along_lattice_line(const World& world, const glm::dvec3& o, int axis
 }  // namespace
 
 Result<RayHit> Queries::ray_cast(const Ray& ray) const {
-  Status s = check_ray(ray);
+  Status s = detail::check_ray(ray, "ray_cast");
   if (!s.ok()) return s;
+  return cast_checked(ray);
+}
+
+RayHit Queries::cast_checked(const Ray& ray) const {
   const World& world = *world_;
   const double h = world.lattice().cell_size;
   const glm::dvec3 dir = glm::normalize(ray.direction);
@@ -203,6 +204,12 @@ Result<RayHit> Queries::ray_cast(const Ray& ray) const {
   } else {
     detail::CellSurface surface;
     uint16_t last_material = 0;
+    // The normal of the cell face the walk entered through (back along the ray for the first cell).
+    auto face_normal = [&](int entry_axis) {
+      glm::vec3 n = entry_axis >= 0 ? glm::vec3(0.0f) : glm::vec3(-dir);
+      if (entry_axis >= 0) n[entry_axis] = d[entry_axis] > 0.0 ? -1.0f : 1.0f;
+      return n;
+    };
     detail::walk_cells(*this, world, o, d, 0.0, ray.max_distance,
                        [&](const glm::ivec3& cell, detail::CellKind kind, double t0, double t1, int entry_axis) {
                          if (kind == detail::CellKind::kInside) {
@@ -210,7 +217,7 @@ Result<RayHit> Queries::ray_cast(const Ray& ray) const {
                            hit.hit = true;
                            hit.distance = t0;
                            hit.material = last_material;
-                           if (entry_axis >= 0) hit.normal[entry_axis] = d[entry_axis] > 0.0 ? -1.0f : 1.0f;
+                           hit.normal = face_normal(entry_axis);
                            return true;
                          }
                          if (!detail::gather_cell_surface(world, cell, &surface)) return false;
@@ -223,12 +230,9 @@ Result<RayHit> Queries::ray_cast(const Ray& ray) const {
                          hit.distance = ch.t;
                          hit.normal = glm::vec3(plane.n);
                          hit.material = plane.material;
-                         if (glm::dot(plane.n, d) > 0.0) {
-                           // Inside the cell's planes on entry, with the nearest plane facing away
-                           // (a step or thin lip between cells): the face entered is the surface hit.
-                           hit.normal = entry_axis >= 0 ? glm::vec3(0.0f) : glm::vec3(-dir);
-                           if (entry_axis >= 0) hit.normal[entry_axis] = d[entry_axis] > 0.0 ? -1.0f : 1.0f;
-                         }
+                         // Inside the cell's planes on entry, with the nearest plane facing away
+                         // (a step or thin lip between cells): the face entered is the surface hit.
+                         if (glm::dot(plane.n, d) > 0.0) hit.normal = face_normal(entry_axis);
                          return true;
                        });
     if (hit.hit && hit.distance <= 0.0) hit.started_inside = true;
@@ -247,12 +251,13 @@ Status Queries::ray_cast(std::span<const Ray> rays, std::span<RayHit> hits, Cont
                                              std::to_string(rays.size()) + " rays"};
   }
   for (size_t i = 0; i < rays.size(); ++i) {
-    Status s = check_ray(rays[i]);
-    if (!s.ok()) return Status(s.code(), "ray " + std::to_string(i) + ": " + s.message());
+    const std::string what = "ray_cast: ray " + std::to_string(i);
+    Status s = detail::check_ray(rays[i], what.c_str());
+    if (!s.ok()) return s;
   }
   ScopedTimer timer(ctx, "ray_cast");
   tbb::parallel_for(tbb::blocked_range<size_t>(0, rays.size(), 256), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i < r.end(); ++i) hits[i] = ray_cast(rays[i]).value();
+    for (size_t i = r.begin(); i < r.end(); ++i) hits[i] = cast_checked(rays[i]);
   });
   return {};
 }

@@ -162,7 +162,10 @@ class Queries {
   const detail::CellIndex* cell_index(const glm::ivec3& c) const;
 
  private:
+  RayHit cast_checked(const Ray& ray) const;  // ray_cast after the ray passed check_ray
   const detail::CellIndex* lookup_slow(const glm::ivec3& c, std::atomic<detail::CellIndex*>* slot) const;
+  size_t slot_count() const;
+  void delete_slots();
   void reset_slots();
 
   const World* world_;

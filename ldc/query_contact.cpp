@@ -9,6 +9,7 @@
 
 #include "ldc/detail/cell_index.h"
 #include "ldc/detail/ray_math.h"
+#include "ldc/detail/vec_text.h"
 #include "ldc/query.h"
 
 namespace ldc {
@@ -22,17 +23,9 @@ constexpr double kDeepCells = 16.0;       // overlap: how far below the surface 
 constexpr double kContactGap = 0.01;      // cells: a sphere this close touches
 constexpr int kMaxCastSteps = 4096;
 
-bool finite3(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
-
-std::string vec_text(const glm::dvec3& v) {
-  std::ostringstream s;
-  s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
-  return s.str();
-}
-
 Status check_point(const char* what, const glm::dvec3& p) {
-  if (finite3(p)) return {};
-  return {ErrorCode::kInvalidArgument, std::string(what) + " " + vec_text(p) + " is not finite"};
+  if (detail::is_finite(p)) return {};
+  return {ErrorCode::kInvalidArgument, std::string(what) + " " + detail::vec_text(p) + " is not finite"};
 }
 
 Status check_positive(const char* what, double value) {
@@ -56,10 +49,6 @@ double box_distance2(const glm::dvec3& x, const glm::dvec3& lo, const glm::dvec3
   return glm::dot(d, d);
 }
 
-glm::ivec3 chunk_of(const glm::ivec3& cell, int c) {
-  return {detail::floor_div(cell.x, c), detail::floor_div(cell.y, c), detail::floor_div(cell.z, c)};
-}
-
 // Bits of a 4^3 brick's word whose cells lie in [lo, hi] (brick-local, inclusive).
 uint64_t brick_range_mask(const glm::ivec3& lo, const glm::ivec3& hi) {
   const uint64_t row = ((uint64_t{1} << (hi.x + 1)) - 1) & ~((uint64_t{1} << lo.x) - 1);
@@ -77,7 +66,7 @@ void for_surface_cells(const Queries& q, const glm::ivec3& lo, const glm::ivec3&
   const glm::ivec3 box_lo = q.world().node_min() - 1, box_hi = q.world().node_end() - 1;
   const glm::ivec3 clo = glm::max(lo, box_lo), chi = glm::min(hi, box_hi);
   if (glm::any(glm::greaterThan(clo, chi))) return;
-  const glm::ivec3 k_lo = chunk_of(clo, c), k_hi = chunk_of(chi, c);
+  const glm::ivec3 k_lo = q.world().chunk_of_node(clo), k_hi = q.world().chunk_of_node(chi);
   for (int kz = k_lo.z; kz <= k_hi.z; ++kz)
     for (int ky = k_lo.y; ky <= k_hi.y; ++ky)
       for (int kx = k_lo.x; kx <= k_hi.x; ++kx) {
@@ -155,7 +144,7 @@ Nearest nearest_surface(const Queries& q, const glm::dvec3& x, double radius) {
 bool inside_solid(const Queries& q, const glm::dvec3& x) {
   const int c = q.world().chunk_size();
   const glm::ivec3 cell(glm::floor(x));
-  const glm::ivec3 k = chunk_of(cell, c);
+  const glm::ivec3 k = q.world().chunk_of_node(cell);  // a cell is named by its first node
   const CellIndex* index = q.cell_index(k);
   if (index->clear) return index->clear_inside;
   const glm::ivec3 l = cell - k * c;
@@ -334,12 +323,7 @@ Result<Overlap> Queries::overlap(const Capsule& capsule) const {
 }
 
 Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
-  Status s = check_point("sphere_cast: origin", ray.origin);
-  if (s.ok()) s = check_point("sphere_cast: direction", ray.direction);
-  if (s.ok() && !(glm::length(ray.direction) > 1e-300))
-    s = Status(ErrorCode::kInvalidArgument, "sphere_cast: direction " + vec_text(ray.direction) + " has no length");
-  if (s.ok() && !(ray.max_distance >= 0.0))
-    s = Status(ErrorCode::kInvalidArgument, "sphere_cast: max_distance must be >= 0");
+  Status s = detail::check_ray(ray, "sphere_cast");
   if (s.ok()) s = check_positive("sphere_cast: radius", radius);
   if (!s.ok()) return s;
   const double h = world_->lattice().cell_size;
@@ -353,24 +337,10 @@ Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
   double t = 0.0;
   for (int step = 0; step < kMaxCastSteps; ++step) {
     const glm::dvec3 x = o + t * dir;
-    // Open space: move by the widest empty box around the sphere (up to 32 cells).
-    if (!any_surface_near(*this, x, search)) {
-      if (inside_solid(*this, x)) {
-        hit.hit = true;
-        hit.started_inside = t == 0.0;
-        hit.distance = t * h;
-        hit.point = hit.started_inside ? ray.origin : world_->lattice().to_world(x);
-        hit.normal = glm::vec3(-dir);
-        return hit;
-      }
-      double free = search;
-      while (free < r + 32.0 && !any_surface_near(*this, x, 2.0 * free)) free *= 2.0;
-      if (t >= t_max) break;
-      t = std::min(t_max, t + free - r);
-      continue;
-    }
     const bool inside = inside_solid(*this, x);
-    Nearest n = nearest_surface(*this, x, search);
+    // The brick scan answers "nothing near" cheaply; only then is the nearest point searched.
+    const bool near = any_surface_near(*this, x, search);
+    const Nearest n = near ? nearest_surface(*this, x, search) : Nearest{};
     const double dist = n.found ? std::sqrt(n.distance2) : search;
     if (inside || dist <= r + kContactGap) {
       hit.hit = true;
@@ -387,7 +357,11 @@ Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
       return hit;
     }
     if (t >= t_max) break;
-    t = std::min(t_max, t + std::max(dist - r, kContactGap));
+    // Open space: move by the widest empty box around the sphere (up to 32 cells).
+    double free = dist;
+    if (!near)
+      while (free < r + 32.0 && !any_surface_near(*this, x, 2.0 * free)) free *= 2.0;
+    t = std::min(t_max, t + std::max(free - r, kContactGap));
   }
   return hit;
 }

@@ -240,11 +240,6 @@ size_t World::chunk_slot(const glm::ivec3& c) const {
   return (static_cast<size_t>(r.z) * config_.chunk_dims.y + r.y) * config_.chunk_dims.x + r.x;
 }
 
-glm::ivec3 World::chunk_of_node(const glm::ivec3& node) const {
-  int c = config_.chunk_size;
-  return {detail::floor_div(node.x, c), detail::floor_div(node.y, c), detail::floor_div(node.z, c)};
-}
-
 ChunkKind World::chunk_kind(const glm::ivec3& c) const {
   return contains_chunk(c) ? kinds_[chunk_slot(c)] : ChunkKind::kEmpty;
 }

@@ -31,6 +31,7 @@
 
 #include <array>
 #include <atomic>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -264,7 +265,13 @@ class World {
 
   bool contains_chunk(const glm::ivec3& chunk) const;
   size_t chunk_slot(const glm::ivec3& chunk) const;  // requires contains_chunk
-  glm::ivec3 chunk_of_node(const glm::ivec3& node) const;
+  // Inline: queries call it for every cell they look at. C is a power of
+  // two, so an arithmetic shift is the floor division.
+  glm::ivec3 chunk_of_node(const glm::ivec3& node) const {
+    const int shift = chunk_shift();
+    return {node.x >> shift, node.y >> shift, node.z >> shift};
+  }
+  int chunk_shift() const { return std::countr_zero(static_cast<unsigned>(config_.chunk_size)); }
   // kEmpty for chunks outside the box.
   ChunkKind chunk_kind(const glm::ivec3& chunk) const;
   // The chunk's data, or nullptr for uniform chunks and chunks outside the box.

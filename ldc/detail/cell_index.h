@@ -12,11 +12,8 @@
 
 #include <glm/glm.hpp>
 
+#include "ldc/query.h"
 #include "ldc/world.h"
-
-namespace ldc {
-class Queries;
-}
 
 namespace ldc::detail {
 
@@ -32,9 +29,10 @@ inline constexpr int kBrickShift = 2;  // bricks of 4^3 cells
 // The cells of one chunk: cell (i, j, k) spans nodes i..i+1, j..j+1, k..k+1
 // (local), so the cells at the far faces need the neighbours' rays.
 struct CellIndex {
-  std::array<const Chunk*, kIndexSources> sources{};
+  // The chunks it was derived from (held, so that no other chunk can take
+  // their addresses while it lives) and their kinds.
+  std::array<std::shared_ptr<const Chunk>, kIndexSources> sources;
   std::array<ChunkKind, kIndexSources> kinds{};
-  std::array<std::shared_ptr<const Chunk>, kIndexSources> keep;  // keeps the addresses unique
   std::atomic<uint64_t> checked_stamp{0};  // world stamp at which the sources were last current
 
   int size = 0;               // C
@@ -57,9 +55,11 @@ struct CellIndex {
   }
   bool is_surface(const glm::ivec3& l) const { return (surface[size_t(brick_of(l))] >> cell_bit(l)) & 1u; }
   bool is_inside(const glm::ivec3& l) const { return (inside[size_t(brick_of(l))] >> cell_bit(l)) & 1u; }
-  bool brick_busy(const glm::ivec3& l) const { return empty_radius[size_t(brick_of(l))] == 0; }
   size_t memory_bytes() const;
 };
+
+// The checks every cast shares; `what` starts the message ("sphere_cast").
+Status check_ray(const Ray& ray, const char* what);
 
 // Whether the index still describes chunk c of the world.
 bool index_current(const CellIndex& index, const World& world, const glm::ivec3& c);
@@ -86,7 +86,6 @@ struct CellSurface {
   std::array<CellPlane, kMaxPlanes> planes;
   int count = 0;
   CellShape shape = CellShape::kConvex;
-  double inv_steps = 0.0;  // cells per depth step
 
   // Signed distance-like value: <= 0 inside the solid model [Units: cells].
   double inside_value(const glm::dvec3& x, int* plane = nullptr) const;

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <limits>
 
@@ -14,9 +13,11 @@
 
 namespace ldc::detail {
 
-// The parameter range [t_in, t_out] in which o + t*d lies in the box [lo, hi].
+// Narrows [t_in, t_out] to where o + t*d lies in the box [lo, hi]; false when
+// nothing is left. entry_axis, when given, becomes the axis of the face the
+// ray enters through if that raised t_in.
 inline bool clip_to_box(const glm::dvec3& o, const glm::dvec3& inv_d, const glm::dvec3& lo, const glm::dvec3& hi,
-                        double* t_in, double* t_out) {
+                        double* t_in, double* t_out, int* entry_axis = nullptr) {
   for (int a = 0; a < 3; ++a) {
     if (std::isinf(inv_d[a])) {
       if (o[a] < lo[a] || o[a] > hi[a]) return false;
@@ -24,7 +25,10 @@ inline bool clip_to_box(const glm::dvec3& o, const glm::dvec3& inv_d, const glm:
     }
     double ta = (lo[a] - o[a]) * inv_d[a], tb = (hi[a] - o[a]) * inv_d[a];
     if (ta > tb) std::swap(ta, tb);
-    *t_in = std::max(*t_in, ta);
+    if (ta > *t_in) {
+      *t_in = ta;
+      if (entry_axis) *entry_axis = a;
+    }
     *t_out = std::min(*t_out, tb);
   }
   return *t_in <= *t_out;
@@ -40,7 +44,6 @@ template <class Visit>
 void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o, const glm::dvec3& d,
                 double t_begin, double t_end, Visit&& visit) {
   const int c = world.chunk_size();
-  const int shift = std::countr_zero(static_cast<unsigned>(c));  // C is a power of two
   // Cells one layer below the box can hold surface: their far edges are the box's face rays.
   const glm::ivec3 box_lo = world.node_min() - 1, box_hi = world.node_end();
   // A zero component counts as positive with an infinite inverse: its exit time is +inf.
@@ -53,13 +56,19 @@ void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o,
   double t = t_begin, t_stop = t_end;
   if (!clip_to_box(o, inv_d, glm::dvec3(box_lo), glm::dvec3(box_hi), &t, &t_stop)) return;
 
-  glm::ivec3 cell;
-  for (int a = 0; a < 3; ++a) cell[a] = std::clamp(fast_floor(o[a] + t * d[a]), box_lo[a], box_hi[a] - 1);
+  // The cell holding o + t*d, kept inside [lo, hi) against rounding at faces.
+  auto cell_at = [&](double t_at, const glm::ivec3& lo, const glm::ivec3& hi, int skip_axis) {
+    glm::ivec3 k(0);  // the caller sets skip_axis's coordinate itself
+    for (int a = 0; a < 3; ++a)
+      if (a != skip_axis) k[a] = std::clamp(fast_floor(o[a] + t_at * d[a]), lo[a], hi[a] - 1);
+    return k;
+  };
+  glm::ivec3 cell = cell_at(t, box_lo, box_hi, -1);
   int entry_axis = -1;
   glm::ivec3 chunk(std::numeric_limits<int>::min());
   const CellIndex* index = nullptr;
   for (;;) {
-    const glm::ivec3 ch(cell.x >> shift, cell.y >> shift, cell.z >> shift);  // floor division
+    const glm::ivec3 ch = world.chunk_of_node(cell);  // a cell is named by its first node
     glm::ivec3 block_lo = cell, block_hi = cell + 1;
     bool skip_chunk = false;
     if (ch != chunk) {
@@ -67,17 +76,15 @@ void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o,
       index = queries.cell_index(ch);
       if (!index->clear) {
         // Jump to where the ray meets the chunk's busy box, or past the chunk if it does not.
-        const glm::dvec3 lo(ch * c + index->busy_lo), hi(ch * c + index->busy_hi);
+        const glm::ivec3 lo = ch * c + index->busy_lo, hi = ch * c + index->busy_hi;
         double t_in = t, t_out = t_stop;
-        if (!clip_to_box(o, inv_d, lo, hi, &t_in, &t_out)) {
+        int busy_entry = entry_axis;
+        if (!clip_to_box(o, inv_d, glm::dvec3(lo), glm::dvec3(hi), &t_in, &t_out, &busy_entry)) {
           skip_chunk = true;
         } else if (t_in > t) {
           t = t_in;
-          for (int a = 0; a < 3; ++a)
-            cell[a] = std::clamp(fast_floor(o[a] + t * d[a]), int(lo[a]), int(hi[a]) - 1);
-          entry_axis = -1;
-          for (int a = 0; a < 3; ++a)
-            if (!std::isinf(inv_d[a]) && ((pos[a] ? lo[a] : hi[a]) - o[a]) * inv_d[a] == t_in) entry_axis = a;
+          cell = cell_at(t, lo, hi, -1);
+          entry_axis = busy_entry;
           block_lo = cell, block_hi = cell + 1;
         }
       }
@@ -112,10 +119,7 @@ void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o,
     }
     if (t_next > t_stop) return;
     t = std::max(t, t_next);
-    for (int a = 0; a < 3; ++a) {
-      if (a == axis) continue;
-      cell[a] = std::clamp(fast_floor(o[a] + t * d[a]), block_lo[a], block_hi[a] - 1);
-    }
+    cell = cell_at(t, block_lo, block_hi, axis);
     cell[axis] = pos[axis] ? block_hi[axis] : block_lo[axis] - 1;
     if (cell[axis] < box_lo[axis] || cell[axis] >= box_hi[axis]) return;
     entry_axis = axis;
