@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "common.h"
+#include "ldc/detail/vec_text.h"
 
 namespace ldc::tool {
 
@@ -18,13 +19,6 @@ Status parse_point(const std::string& option, const std::string& text, glm::dvec
 }
 
 }  // namespace
-
-std::string vec3_text(const glm::dvec3& v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << "(" << v.x << ", " << v.y << ", " << v.z << ")";
-  return s.str();
-}
 
 void add_camera_options(CLI::App* cmd, CameraArgs& args, const std::string& what) {
   cmd->add_option("--camera", args.camera, "Camera position x,y,z" + what);
@@ -58,7 +52,7 @@ Status check_camera_args(const CameraArgs& args) {
   }
   if (!args.camera.empty() && !args.target.empty() && camera == target) {
     return Status(ErrorCode::kInvalidArgument,
-                  "--camera and --target are the same point " + vec3_text(camera) + ": the view has no direction");
+                  "--camera and --target are the same point " + detail::vec_text(camera) + ": the view has no direction");
   }
   return {};
 }
@@ -85,7 +79,7 @@ Result<Camera> Camera::make(const CameraArgs& args, const World* world) {
     parse_vec3(args.camera, &c.position_);
     if (c.position_ == c.target_) {  // the camera at the default target
       return Status(ErrorCode::kInvalidArgument,
-                    "--camera " + vec3_text(c.position_) + " is the target (the solid's centre): give --target");
+                    "--camera " + detail::vec_text(c.position_) + " is the target (the solid's centre): give --target");
     }
     c.set_basis();
     return c;

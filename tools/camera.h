@@ -70,7 +70,5 @@ class Camera {
   double tan_half_ = 1.0;  // tan(fov / 2): the image's half height at distance 1
 };
 
-// "(x, y, z)" with up to 6 significant digits, for messages and reports.
-std::string vec3_text(const glm::dvec3& v);
 
 }  // namespace ldc::tool

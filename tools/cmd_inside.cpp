@@ -7,6 +7,7 @@
 
 #include "common.h"
 #include "ldc/io.h"
+#include "ldc/detail/vec_text.h"
 
 namespace ldc::tool {
 namespace {
@@ -34,7 +35,7 @@ Result<std::vector<glm::dvec3>> read_points(std::istream& in, const std::string&
     if (!(s >> p.y >> p.z) || (s >> rest)) {
       return Status(ErrorCode::kParseError, name + ":" + std::to_string(n) + ": expected three numbers");
     }
-    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) {
+    if (!detail::is_finite(p)) {
       return Status(ErrorCode::kParseError, name + ":" + std::to_string(n) + ": coordinate is not finite");
     }
     out.push_back(p);

@@ -9,6 +9,7 @@
 
 #include "camera.h"
 #include "common.h"
+#include "ldc/detail/vec_text.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
 
@@ -49,15 +50,14 @@ std::string number_text(double d) {
 
 // The checks Queries::ray_cast makes, with the ray's index and field named.
 Status check_ray_fields(const Ray& r, const std::string& where) {
-  auto finite = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
-  if (!finite(r.origin)) return {ErrorCode::kInvalidArgument, where + "field 'origin' must hold finite numbers"};
-  if (!finite(r.direction)) {
+  if (!detail::is_finite(r.origin)) return {ErrorCode::kInvalidArgument, where + "field 'origin' must hold finite numbers"};
+  if (!detail::is_finite(r.direction)) {
     return {ErrorCode::kInvalidArgument, where + "field 'direction' must hold finite numbers"};
   }
   const double len = glm::length(r.direction);
   if (!(len > 1e-300) || !std::isfinite(len)) {
     return {ErrorCode::kInvalidArgument,
-            where + "field 'direction' " + vec3_text(r.direction) + " has no usable length (zero or overflowing)"};
+            where + "field 'direction' " + detail::vec_text(r.direction) + " has no usable length (zero or overflowing)"};
   }
   if (!(r.max_distance >= 0.0)) {
     return {ErrorCode::kInvalidArgument, where + "field 'max_distance' " + number_text(r.max_distance) +
@@ -80,22 +80,6 @@ Result<glm::dvec3> json_vec3(const nlohmann::json& v, const std::string& where, 
     out[i] = v[i].get<double>();
   }
   return out;
-}
-
-Result<nlohmann::json> read_json_file(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return Status(ErrorCode::kIoError, path + ": cannot open");
-  std::ostringstream text;
-  text << f.rdbuf();
-  try {
-    return nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::exception& e) {
-    std::string hint = std::string(e.what()).find("invalid literal") != std::string::npos ||
-                               std::string(e.what()).find("overflow") != std::string::npos
-                           ? " (JSON has no NaN or Infinity: every number must be finite)"
-                           : "";
-    return Status(ErrorCode::kParseError, path + ": malformed JSON: " + e.what() + hint);
-  }
 }
 
 Result<std::vector<Ray>> read_rays(const std::string& path) {
@@ -184,7 +168,7 @@ Result<RaySource> make_rays(const RaycastArgs& a, const World& world) {
     }
     if (!(glm::length(r.direction) > 1e-300) || !std::isfinite(glm::length(r.direction))) {
       return Status(ErrorCode::kInvalidArgument,
-                    "--direction " + vec3_text(r.direction) + " has no usable length (zero or overflowing)");
+                    "--direction " + detail::vec_text(r.direction) + " has no usable length (zero or overflowing)");
     }
     src.rays.push_back(r);
     src.name = "ray";
@@ -261,7 +245,7 @@ void print_summary(std::FILE* f, const nlohmann::json& s, const std::vector<RayH
   if (s.contains("camera")) {
     const auto& c = s["camera"];
     auto v = [](const nlohmann::json& a) {
-      return vec3_text({a[0].get<double>(), a[1].get<double>(), a[2].get<double>()});
+      return detail::vec_text({a[0].get<double>(), a[1].get<double>(), a[2].get<double>()});
     };
     std::fprintf(f, "camera %s -> target %s, fov %g, %d x %d\n", v(c["position"]).c_str(), v(c["target"]).c_str(),
                  c["fov"].get<double>(), c["width"].get<int>(), c["height"].get<int>());
@@ -272,7 +256,7 @@ void print_summary(std::FILE* f, const nlohmann::json& s, const std::vector<RayH
       std::fprintf(f, "no hit\n");
     } else {
       std::fprintf(f, "hit at distance %.6g: point %s, normal %s, material %u%s\n", h.distance,
-                   vec3_text(h.point).c_str(), vec3_text(glm::dvec3(h.normal)).c_str(), unsigned(h.material),
+                   detail::vec_text(h.point).c_str(), detail::vec_text(glm::dvec3(h.normal)).c_str(), unsigned(h.material),
                    h.started_inside ? " (started inside the solid)" : "");
     }
   }

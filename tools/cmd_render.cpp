@@ -16,6 +16,7 @@
 
 #include "camera.h"
 #include "common.h"
+#include "ldc/detail/vec_text.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
 
@@ -215,16 +216,9 @@ Result<std::vector<glm::dvec3>> overlay_points(const nlohmann::json& list, const
 }
 
 Result<Overlay> read_overlay(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return Status(ErrorCode::kIoError, "--overlay " + path + ": cannot open");
-  std::ostringstream text;
-  text << f.rdbuf();
-  nlohmann::json doc;
-  try {
-    doc = nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::exception& e) {
-    return Status(ErrorCode::kParseError, "--overlay " + path + ": malformed JSON: " + e.what());
-  }
+  Result<nlohmann::json> read = read_json_file(path);
+  if (!read.ok()) return Status(read.status().code(), "--overlay " + read.status().message());
+  const nlohmann::json& doc = read.value();
   const std::string usage = " (expected {\"path\": [[x,y,z], ...]} and/or {\"points\": [[x,y,z], ...]}; "
                             "\"polyline\" is taken for \"path\")";
   if (!doc.is_object()) return Status(ErrorCode::kParseError, "--overlay " + path + ": not a JSON object" + usage);
@@ -487,7 +481,7 @@ int run_render(const RenderArgs& a, const CommonOptions& common) {
               img.width, img.height, stats.rays, shadow.str().c_str(), 100.0 * hit_fraction, stats.cast_seconds, mrays,
               report["threads"].get<int>(), seconds["total"].get<double>());
   std::printf("camera %s -> target %s, fov %g  (--camera %.6g,%.6g,%.6g --target %.6g,%.6g,%.6g)\n",
-              vec3_text(c.position()).c_str(), vec3_text(c.target()).c_str(), c.fov(), c.position().x,
+              detail::vec_text(c.position()).c_str(), detail::vec_text(c.target()).c_str(), c.fov(), c.position().x,
               c.position().y, c.position().z, c.target().x, c.target().y, c.target().z);
   if (stats.started_inside) {
     std::printf("warning: %zu rays started inside the solid (the camera is inside it; shown purple)\n",

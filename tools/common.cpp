@@ -4,10 +4,13 @@
 
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
 #include <sstream>
 
 #include <tbb/global_control.h>
+
+#include "ldc/detail/vec_text.h"
 
 namespace ldc::tool {
 
@@ -50,6 +53,21 @@ int fail(const std::string& command, const std::string& message) {
   return 1;
 }
 
+Result<nlohmann::json> read_json_file(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return Status(ErrorCode::kIoError, path + ": cannot open");
+  std::ostringstream text;
+  text << f.rdbuf();
+  try {
+    return nlohmann::json::parse(text.str());
+  } catch (const nlohmann::json::exception& e) {  // syntax errors, and numbers too large for a double
+    const std::string what = e.what();
+    const bool not_finite = what.find("invalid literal") != std::string::npos || what.find("overflow") != std::string::npos;
+    return Status(ErrorCode::kParseError, path + ": malformed JSON: " + what +
+                                              (not_finite ? " (JSON has no NaN or Infinity: every number must be finite)" : ""));
+  }
+}
+
 bool parse_vec3(const std::string& text, glm::dvec3* out) {
   std::istringstream in(text);
   char c1 = 0, c2 = 0;
@@ -57,7 +75,7 @@ bool parse_vec3(const std::string& text, glm::dvec3* out) {
   if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',') return false;
   std::string rest;
   if (in >> rest) return false;
-  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return false;
+  if (!detail::is_finite(v)) return false;
   *out = v;
   return true;
 }

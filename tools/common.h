@@ -47,6 +47,10 @@ class ProgressBar {
 int fail(const std::string& command, const Status& status);
 int fail(const std::string& command, const std::string& message);
 
+// Reads and parses a JSON file; errors name the file (and, for NaN or
+// Infinity, which JSON cannot hold, say so).
+Result<nlohmann::json> read_json_file(const std::string& path);
+
 // "1,2,3" -> vector; false when malformed.
 bool parse_vec3(const std::string& text, glm::dvec3* out);
 

@@ -12,6 +12,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common.h"
+
 namespace ldc::tool {
 
 const char* const kEditScriptHelp = R"(Script (JSON): {"edits": [ edit, ... ]}, applied in order. Every edit has
@@ -250,18 +252,6 @@ Result<ScriptEdit> read_edit(const nlohmann::json& edit, size_t index, MeshFiles
   return ScriptEdit{brush_name, WorldEditor::Edit{std::move(brush), *op}};
 }
 
-Result<nlohmann::json> parse_json_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) return Status(ErrorCode::kIoError, path + ": cannot open");
-  std::ostringstream text;
-  text << in.rdbuf();
-  try {
-    return nlohmann::json::parse(text.str());
-  } catch (const nlohmann::json::exception& e) {  // syntax errors, and numbers too large for a double
-    return Status(ErrorCode::kParseError, path + ": malformed JSON: " + e.what());
-  }
-}
-
 Status check_top_level(const nlohmann::json& doc) {
   if (!doc.is_object()) return {ErrorCode::kInvalidArgument, "the script must be an object {\"edits\": [...]}"};
   for (const auto& [name, value] : doc.items()) {
@@ -275,7 +265,7 @@ Status check_top_level(const nlohmann::json& doc) {
 }  // namespace
 
 Result<std::vector<ScriptEdit>> read_edit_script(const std::string& path) {
-  Result<nlohmann::json> doc = parse_json_file(path);
+  Result<nlohmann::json> doc = read_json_file(path);
   if (!doc.ok()) return doc.status();
   Status s = check_top_level(doc.value());
   if (!s.ok()) return Status(s.code(), path + ": " + s.message());
