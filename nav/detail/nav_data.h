@@ -1,0 +1,139 @@
+// Internals of nav/: tiles of floors, rectangles, portals. Everything here is
+// in lattice units: a column is named by its global node coordinates (u, v)
+// on the two horizontal axes (axis_u(up), axis_v(up)), a height is a depth
+// along the up axis in cells.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "ldc/world.h"
+#include "nav/nav.h"
+
+namespace ldc::detail {
+
+inline constexpr uint8_t kNoLink = 0xFF;
+inline constexpr uint16_t kNoRegion = 0xFFFF;
+inline constexpr int kMaxLevels = 254;  // floors per column kept (link indices are bytes)
+// Floors per tile kept (16-bit offsets and region ids); only a tile of
+// 32 x 32 columns with over 60 walkable levels each reaches it.
+inline constexpr size_t kMaxTileFloors = 65000;
+
+// Directions in the ground plane: 0 +u, 1 +v, 2 -u, 3 -v.
+inline constexpr glm::ivec2 kDirStep[4] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
+inline constexpr int opposite(int dir) { return (dir + 2) & 3; }
+
+// One floor: the top of a solid span with a walkable slope and enough room above.
+struct NavFloor {
+  float height = 0.0f;   // depth of the floor along up [Units: cells]
+  float ceiling = 0.0f;  // depth of the next solid above, or +inf
+  uint8_t link[4] = {kNoLink, kNoLink, kNoLink, kNoLink};  // floor index in the neighbour column
+  bool kept = false;     // survived erosion
+  uint8_t pad = 0;
+  uint16_t region = kNoRegion;  // rectangle (local to the tile) holding it
+};
+
+// A rectangle of columns [lo, hi] (inclusive, global) whose floors are linked.
+struct NavRegion {
+  glm::ivec2 lo{0};
+  glm::ivec2 hi{0};
+  float height_min = 0.0f;
+  float height_max = 0.0f;
+  uint32_t first_portal = 0;  // into NavTile::portals
+  uint32_t portal_count = 0;
+  uint32_t component = 0;     // connected island id (valid after relabelling)
+};
+
+// A directed portal from a region to a neighbouring one: the shared side's
+// segment from a to b (2D lattice coordinates), heights at both ends.
+struct NavPortal {
+  uint32_t to_tile = 0;
+  uint16_t to_region = 0;
+  uint8_t dir = 0;  // side of the source region it lies on
+  glm::vec2 a{0.0f};
+  glm::vec2 b{0.0f};
+  float height_a = 0.0f;
+  float height_b = 0.0f;
+};
+
+struct NavTile {
+  glm::ivec2 coord{0};                 // chunk coordinates on (u, v)
+  std::vector<uint16_t> column_first;  // C*C + 1 offsets into floors; empty when no floors
+  std::vector<NavFloor> floors;
+  std::vector<NavRegion> regions;
+  std::vector<NavPortal> portals;      // grouped by region
+  uint32_t dense_first = 0;            // first dense region index (for searches)
+  uint32_t dense_floor_first = 0;      // first dense floor index (for grid searches)
+
+  bool empty() const { return floors.empty(); }
+  size_t memory_bytes() const;
+};
+
+struct NavData {
+  NavConfig config;
+  Lattice lattice;
+  int chunk_size = 32;
+  int up = 2, axis_u = 0, axis_v = 1;  // lattice axes
+  glm::ivec2 tile_origin{0};           // first tile (chunk coordinates on u, v)
+  glm::ivec2 tile_dims{0};
+  glm::ivec3 world_chunk_origin{0};    // box the mesh was built for
+  glm::ivec3 world_chunk_dims{0};
+  // Agent limits in cells.
+  float climb_cells = 0.0f;
+  float height_cells = 0.0f;
+  float min_normal_up = 0.0f;
+  int erode_cells = 0;                 // ceil(radius / h)
+  std::vector<NavTile> tiles;          // tile_dims.x * tile_dims.y, x fastest
+  std::vector<uint32_t> dense_tile;    // dense region index -> tile slot
+  uint32_t dense_count = 0;
+  uint32_t dense_floor_count = 0;
+  uint32_t component_count = 0;
+
+  int tile_slot(const glm::ivec2& tile) const {
+    const glm::ivec2 t = tile - tile_origin;
+    return t.y * tile_dims.x + t.x;
+  }
+  bool contains_tile(const glm::ivec2& tile) const {
+    const glm::ivec2 t = tile - tile_origin;
+    return t.x >= 0 && t.y >= 0 && t.x < tile_dims.x && t.y < tile_dims.y;
+  }
+  glm::ivec2 tile_of_column(const glm::ivec2& column) const {
+    const int shift = std::countr_zero(static_cast<unsigned>(chunk_size));
+    return {column.x >> shift, column.y >> shift};
+  }
+  // Floors of a global column; empty when outside the mesh or floorless.
+  std::span<const NavFloor> column(const glm::ivec2& column) const;
+  int column_first(const glm::ivec2& column, int* tile_slot_out) const;
+
+  // Lattice (u, v, up) of a world position, and back.
+  glm::dvec3 to_nav(const glm::dvec3& world) const;
+  glm::dvec3 to_world(const glm::dvec3& nav) const;
+};
+
+// Region reference: tile slot in the high bits, region in the low 16.
+inline uint64_t region_ref(uint32_t tile, uint16_t region) {
+  return (uint64_t{tile} << 16) | region;
+}
+inline uint32_t ref_tile(uint64_t ref) { return uint32_t(ref >> 16); }
+inline uint16_t ref_region(uint64_t ref) { return uint16_t(ref & 0xFFFF); }
+
+// --- building steps (nav/tile_build.cpp) ---
+void setup_nav_data(NavData& data, const World& world, const NavConfig& config);
+// Floors of one tile from the world's vertical rays; links within the tile
+// and to the neighbours' floors are left for link_tile().
+void extract_tile(const NavData& data, const World& world, NavTile& tile);
+// Links every floor of the tile to its neighbour columns' floors (neighbour
+// tiles must be extracted).
+void link_tile(const NavData& data, NavTile& tile);
+// Erosion (needs the neighbours linked), then rectangles.
+void erode_tile(const NavData& data, NavTile& tile);
+void cover_tile(const NavData& data, NavTile& tile);
+// Portals of every region of the tile (neighbours covered).
+void connect_tile(const NavData& data, NavTile& tile);
+// Dense numbering and connected components over all tiles.
+void relabel(NavData& data);
+
+}  // namespace ldc::detail

@@ -1,0 +1,88 @@
+// Internals of nav/: search state kept by a NavQuery between calls.
+// Positions are nav coordinates (u, v, height) in cells.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "nav/detail/nav_data.h"
+
+namespace ldc::detail {
+
+struct FloorHit {
+  int tile = 0;          // tile slot
+  uint32_t floor = 0;    // index in the tile's floors
+  glm::dvec3 point{0.0};
+  double distance = 0.0;
+};
+
+// The kept floor nearest q within reach (both in cells), searched in rings of columns.
+std::optional<FloorHit> nearest_floor(const NavData& data, const glm::dvec3& q,
+                                      const glm::dvec3& reach);
+
+// The region of a dense index (and its tile slot when asked).
+const NavRegion& dense_to_region(const NavData& data, uint32_t dense, uint32_t* slot = nullptr);
+// The point of region `dense` nearest q: inside its rectangle, on its floor.
+glm::dvec3 nearest_point_of_region(const NavData& data, uint32_t dense, const glm::dvec3& q);
+
+// Per-node arrays stamped with a generation, so a new search needs no clearing.
+struct SearchNodes {
+  std::vector<uint32_t> stamp;
+  std::vector<float> cost;           // g
+  std::vector<uint32_t> parent;      // node index, or UINT32_MAX
+  std::vector<uint32_t> via;         // region search: portal index in the parent's tile
+  std::vector<glm::dvec3> position;  // where the node is entered
+  std::vector<uint8_t> closed;
+  std::vector<std::pair<float, uint32_t>> heap;  // (f, node), min-heap by f
+  uint32_t generation = 0;
+  int used = 0;
+
+  void reset(uint32_t count);
+  bool seen(uint32_t n) const { return stamp[n] == generation; }
+  void touch(uint32_t n);
+  void push(uint32_t n, float f);
+  bool pop(uint32_t* n);
+};
+
+struct GridSearchState {
+  SearchNodes nodes;
+};
+
+// A* over the 8-connected floor grid (no corner cutting); lengths in cells.
+NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& goal,
+                    int max_nodes, GridSearchState& state);
+
+struct NavSearch {
+  SearchNodes nodes;
+  GridSearchState grid;
+  bool active = false;
+  bool done = false;
+  bool reached = false;
+  bool out_of_nodes = false;
+  bool goal_reachable = false;
+  glm::dvec3 start{0.0}, target{0.0};
+  uint32_t start_region = 0, target_region = 0;
+  uint32_t best = 0;  // explored node nearest the target
+  double best_distance = 0.0;
+
+  void reset(uint32_t region_count);
+  void push_start(uint32_t region, const glm::dvec3& at, double to_target);
+  // Expands the cheapest open node; false when the search is over.
+  bool expand_one(const NavData& data, int max_nodes);
+  // The corridor to the target (or the best node) pulled taut; lengths in cells.
+  NavPath make_path(const NavData& data) const;
+};
+
+// String pulling through a corridor's portals: corners[0] = start, last =
+// end; `left`/`right` are the portal ends as seen walking through them.
+struct FunnelPortal {
+  glm::dvec3 left{0.0};
+  glm::dvec3 right{0.0};
+};
+std::vector<glm::dvec3> pull_string(const glm::dvec3& start, const glm::dvec3& end,
+                                    const std::vector<FunnelPortal>& portals);
+
+}  // namespace ldc::detail

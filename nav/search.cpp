@@ -1,0 +1,214 @@
+// NavQuery: nearest walkable floor, A* over rectangles with a node budget
+// (in slices), string pulling, and the plain grid A* baseline.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include "ldc/detail/vec_text.h"
+#include "nav/detail/nav_data.h"
+#include "nav/detail/nav_search.h"
+
+namespace ldc {
+
+using detail::NavData;
+using detail::NavFloor;
+using detail::NavPortal;
+using detail::NavRegion;
+using detail::NavTile;
+
+namespace detail {
+
+// ---- nearest floor ---------------------------------------------------------
+
+std::optional<FloorHit> nearest_floor(const NavData& data, const glm::dvec3& q,
+                                      const glm::dvec3& reach) {
+  // q and reach in nav coordinates (cells). Rings of columns outward from
+  // q's column; stops once a ring is farther than the best hit.
+  std::optional<FloorHit> best;
+  const glm::ivec2 centre(int(std::lround(q.x)), int(std::lround(q.y)));
+  const int rings = int(std::ceil(std::max(reach.x, reach.y))) + 1;
+  for (int ring = 0; ring <= rings; ++ring) {
+    const double ring_gap = std::max(0.0, ring - 1.0);  // least horizontal distance in this ring
+    if (best && ring_gap > best->distance) break;
+    for (int dy = -ring; dy <= ring; ++dy) {
+      for (int dx = -ring; dx <= ring; ++dx) {
+        if (std::max(std::abs(dx), std::abs(dy)) != ring) continue;
+        const glm::ivec2 col = centre + glm::ivec2(dx, dy);
+        // The nearest point of the column's square.
+        const glm::dvec2 p(std::clamp(q.x, col.x - 0.5, col.x + 0.5),
+                           std::clamp(q.y, col.y - 0.5, col.y + 0.5));
+        if (std::abs(p.x - q.x) > reach.x || std::abs(p.y - q.y) > reach.y) continue;
+        int slot = 0;
+        const int index = data.column_first(col, &slot);
+        if (index < 0) continue;
+        const NavTile& t = data.tiles[size_t(slot)];
+        for (uint32_t i = t.column_first[size_t(index)]; i < t.column_first[size_t(index) + 1]; ++i) {
+          const NavFloor& f = t.floors[i];
+          if (!f.kept || f.region == kNoRegion) continue;
+          if (std::abs(f.height - q.z) > reach.z) continue;
+          const glm::dvec3 at(p, f.height);
+          const double d = glm::length(at - q);
+          if (!best || d < best->distance) best = FloorHit{slot, i, at, d};
+        }
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace detail
+
+namespace {
+
+Status not_finite(const char* what, const glm::dvec3& p) {
+  return Status(ErrorCode::kInvalidArgument,
+                std::string(what) + " " + detail::vec_text(p) + " is not finite");
+}
+
+glm::dvec3 to_nav_extent(const NavData& data, const glm::dvec3& half) {
+  const double h = data.lattice.cell_size;
+  return glm::dvec3(half[data.axis_u], half[data.axis_v], half[data.up]) / h;
+}
+
+Status check_extents(const glm::dvec3& half) {
+  if (!detail::is_finite(half) || half.x <= 0 || half.y <= 0 || half.z <= 0) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "search half extents " + detail::vec_text(half) + " must be finite and > 0");
+  }
+  return {};
+}
+
+uint32_t dense_region(const NavData& data, const detail::FloorHit& hit) {
+  const NavTile& t = data.tiles[size_t(hit.tile)];
+  return t.dense_first + t.floors[hit.floor].region;
+}
+
+}  // namespace
+
+// ---- NavQuery --------------------------------------------------------------
+
+NavQuery::NavQuery(const NavMesh& mesh, int max_nodes)
+    : mesh_(mesh),
+      max_nodes_(std::clamp(max_nodes, 16, 1 << 20)),
+      search_(std::make_unique<detail::NavSearch>()) {}
+
+NavQuery::~NavQuery() = default;
+
+Result<NavPoint> NavQuery::nearest_walkable(const glm::dvec3& p, const glm::dvec3& half) const {
+  if (!detail::is_finite(p)) return not_finite("position", p);
+  if (Status s = check_extents(half); !s.ok()) return s;
+  const NavData& data = *mesh_.data_;
+  const auto hit = detail::nearest_floor(data, data.to_nav(p), to_nav_extent(data, half));
+  if (!hit) {
+    return Status(ErrorCode::kInvalidArgument, "no walkable floor within " +
+                                                   detail::vec_text(half) + " m of " +
+                                                   detail::vec_text(p));
+  }
+  NavPoint out;
+  out.position = data.to_world(hit->point);
+  out.region = detail::region_ref(uint32_t(hit->tile), data.tiles[size_t(hit->tile)].floors[hit->floor].region);
+  out.distance = hit->distance * data.lattice.cell_size;
+  return out;
+}
+
+Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
+                            const PathQueryOptions& options) {
+  detail::NavSearch& s = *search_;
+  s.active = false;
+  if (!detail::is_finite(from)) return not_finite("path start", from);
+  if (!detail::is_finite(to)) return not_finite("path goal", to);
+  if (Status st = check_extents(options.search_half_extents); !st.ok()) return st;
+  const NavData& data = *mesh_.data_;
+  const glm::dvec3 reach = to_nav_extent(data, options.search_half_extents);
+  const auto start = detail::nearest_floor(data, data.to_nav(from), reach);
+  if (!start) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "no walkable floor within " + detail::vec_text(options.search_half_extents) +
+                      " m of the path start " + detail::vec_text(from));
+  }
+  s.reset(data.dense_count);
+  s.start = start->point;
+  s.start_region = dense_region(data, *start);
+  const uint32_t island = detail::dense_to_region(data, s.start_region).component;
+  const glm::dvec3 goal_nav = data.to_nav(to);
+  const auto goal = detail::nearest_floor(data, goal_nav, reach);
+  if (goal && detail::dense_to_region(data, dense_region(data, *goal)).component == island) {
+    s.target = goal->point;
+    s.target_region = dense_region(data, *goal);
+    s.goal_reachable = true;
+  } else {
+    // Unreachable: aim at the start island's point nearest the goal.
+    const glm::dvec3 aim = goal ? goal->point : goal_nav;
+    double best = std::numeric_limits<double>::infinity();
+    for (uint32_t r = 0; r < data.dense_count; ++r) {
+      if (detail::dense_to_region(data, r).component != island) continue;
+      const glm::dvec3 p = detail::nearest_point_of_region(data, r, aim);
+      const double d = glm::length(p - aim);
+      if (d < best) {
+        best = d;
+        s.target = p;
+        s.target_region = r;
+      }
+    }
+    s.goal_reachable = false;
+  }
+  s.push_start(s.start_region, s.start, glm::length(s.target - s.start));
+  s.active = true;
+  return {};
+}
+
+Result<SliceStatus> NavQuery::step(int max_expansions) {
+  detail::NavSearch& s = *search_;
+  if (!s.active) return Status(ErrorCode::kInvalidArgument, "step() without a begun path search");
+  if (s.done) return SliceStatus::kDone;
+  const NavData& data = *mesh_.data_;
+  for (int e = 0; e < max_expansions; ++e) {
+    if (!s.expand_one(data, max_nodes_)) return SliceStatus::kDone;
+  }
+  return s.done ? SliceStatus::kDone : SliceStatus::kInProgress;
+}
+
+Result<NavPath> NavQuery::finish_path() {
+  detail::NavSearch& s = *search_;
+  if (!s.active) return Status(ErrorCode::kInvalidArgument, "finish_path() without a begun path search");
+  const NavData& data = *mesh_.data_;
+  NavPath path = s.make_path(data);
+  for (glm::dvec3& p : path.corners) p = data.to_world(p);
+  path.length *= data.lattice.cell_size;
+  s.active = false;
+  return path;
+}
+
+Result<NavPath> NavQuery::find_path(const glm::dvec3& from, const glm::dvec3& to,
+                                    const PathQueryOptions& options) {
+  if (Status st = begin_path(from, to, options); !st.ok()) return st;
+  while (true) {
+    Result<SliceStatus> r = step(1 << 30);
+    if (!r.ok()) return r.status();
+    if (r.value() == SliceStatus::kDone) break;
+  }
+  return finish_path();
+}
+
+Result<NavPath> NavQuery::find_grid_path(const glm::dvec3& from, const glm::dvec3& to,
+                                         const PathQueryOptions& options) {
+  if (!detail::is_finite(from)) return not_finite("path start", from);
+  if (!detail::is_finite(to)) return not_finite("path goal", to);
+  if (Status st = check_extents(options.search_half_extents); !st.ok()) return st;
+  const NavData& data = *mesh_.data_;
+  const glm::dvec3 reach = to_nav_extent(data, options.search_half_extents);
+  const auto start = detail::nearest_floor(data, data.to_nav(from), reach);
+  const auto goal = detail::nearest_floor(data, data.to_nav(to), reach);
+  if (!start || !goal) {
+    return Status(ErrorCode::kInvalidArgument,
+                  std::string("no walkable floor within the search extents of the path ") +
+                      (start ? "goal " + detail::vec_text(to) : "start " + detail::vec_text(from)));
+  }
+  NavPath path = detail::grid_search(data, *start, *goal, max_nodes_, search_->grid);
+  for (glm::dvec3& p : path.corners) p = data.to_world(p);
+  path.length *= data.lattice.cell_size;
+  return path;
+}
+
+}  // namespace ldc

@@ -1,0 +1,529 @@
+// Building one tile: floors from the vertical rays, links to the neighbour
+// columns, erosion by the agent radius, rectangles, portals.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "nav/detail/nav_data.h"
+
+namespace ldc::detail {
+
+size_t NavTile::memory_bytes() const {
+  return sizeof(NavTile) + column_first.capacity() * sizeof(uint16_t) +
+         floors.capacity() * sizeof(NavFloor) + regions.capacity() * sizeof(NavRegion) +
+         portals.capacity() * sizeof(NavPortal);
+}
+
+int NavData::column_first(const glm::ivec2& col, int* slot_out) const {
+  const glm::ivec2 tile = tile_of_column(col);
+  if (!contains_tile(tile)) return -1;
+  const int slot = tile_slot(tile);
+  const NavTile& t = tiles[size_t(slot)];
+  if (t.empty()) return -1;
+  const glm::ivec2 local = col - tile * chunk_size;
+  if (slot_out) *slot_out = slot;
+  return local.y * chunk_size + local.x;
+}
+
+std::span<const NavFloor> NavData::column(const glm::ivec2& col) const {
+  int slot = 0;
+  const int index = column_first(col, &slot);
+  if (index < 0) return {};
+  const NavTile& t = tiles[size_t(slot)];
+  return {t.floors.data() + t.column_first[size_t(index)],
+          size_t(t.column_first[size_t(index) + 1] - t.column_first[size_t(index)])};
+}
+
+glm::dvec3 NavData::to_nav(const glm::dvec3& world) const {
+  const glm::dvec3 l = lattice.to_lattice(world);
+  return {l[axis_u], l[axis_v], l[up]};
+}
+
+glm::dvec3 NavData::to_world(const glm::dvec3& nav) const {
+  glm::dvec3 l;
+  l[axis_u] = nav.x;
+  l[axis_v] = nav.y;
+  l[up] = nav.z;
+  return lattice.to_world(l);
+}
+
+void setup_nav_data(NavData& data, const World& world, const NavConfig& config) {
+  data.config = config;
+  data.lattice = world.lattice();
+  data.chunk_size = world.chunk_size();
+  data.up = config.up_axis;
+  data.axis_u = axis_u(config.up_axis);
+  data.axis_v = axis_v(config.up_axis);
+  const glm::ivec3 o = world.chunk_origin(), d = world.chunk_dims();
+  data.world_chunk_origin = o;
+  data.world_chunk_dims = d;
+  data.tile_origin = {o[data.axis_u], o[data.axis_v]};
+  data.tile_dims = {d[data.axis_u], d[data.axis_v]};
+  const double h = world.lattice().cell_size;
+  data.climb_cells = float(config.max_climb / h);
+  data.height_cells = float(config.agent_height / h);
+  data.min_normal_up = float(std::cos(config.max_slope_degrees * M_PI / 180.0));
+  data.erode_cells = int(std::ceil(config.agent_radius / h - 1e-9));
+  data.tiles.assign(size_t(data.tile_dims.x) * size_t(data.tile_dims.y), NavTile{});
+  for (int y = 0; y < data.tile_dims.y; ++y) {
+    for (int x = 0; x < data.tile_dims.x; ++x) {
+      data.tiles[size_t(y * data.tile_dims.x + x)].coord = data.tile_origin + glm::ivec2(x, y);
+    }
+  }
+}
+
+// ---- floors ----------------------------------------------------------------
+
+namespace {
+
+// The chunks of one tile's vertical stack, bottom to top (nullptr: uniform).
+std::vector<const Chunk*> tile_stack(const NavData& data, const World& world,
+                                     const glm::ivec2& tile) {
+  std::vector<const Chunk*> stack;
+  glm::ivec3 ch(0);
+  ch[data.axis_u] = tile.x;
+  ch[data.axis_v] = tile.y;
+  for (int k = 0; k < data.world_chunk_dims[data.up]; ++k) {
+    ch[data.up] = data.world_chunk_origin[data.up] + k;
+    stack.push_back(world.chunk(ch));
+  }
+  return stack;
+}
+
+}  // namespace
+
+void extract_tile(const NavData& data, const World& world, NavTile& tile) {
+  tile.floors.clear();
+  tile.regions.clear();
+  tile.portals.clear();
+  tile.column_first.clear();
+  const int c = data.chunk_size;
+  const std::vector<const Chunk*> stack = tile_stack(data, world, tile.coord);
+  if (std::all_of(stack.begin(), stack.end(), [](const Chunk* ch) { return ch == nullptr; })) {
+    return;  // uniform all the way up: no surface, no floors
+  }
+  const double steps = depth_steps_per_cell(c);
+  const int bottom = data.world_chunk_origin[data.up] * c;
+  tile.column_first.assign(size_t(c * c + 1), 0);
+  for (int ray = 0; ray < c * c; ++ray) {
+    tile.column_first[size_t(ray)] = uint16_t(tile.floors.size());
+    const size_t column_start = tile.floors.size();
+    bool open_floor = false;  // the last floor waits for its ceiling
+    for (size_t k = 0; k < stack.size(); ++k) {
+      if (!stack[k]) continue;
+      const double segment = bottom + double(k) * c;
+      for (const PackedPoint& p : stack[k]->axis[size_t(data.up)].points(ray)) {
+        const double depth = segment + p.depth / steps;
+        if (p.enters()) {
+          if (open_floor) tile.floors.back().ceiling = float(depth);
+          open_floor = false;
+          continue;
+        }
+        if (tile.floors.size() - column_start >= size_t(kMaxLevels)) continue;
+        if (tile.floors.size() >= kMaxTileFloors) continue;
+        NavFloor f;
+        f.height = float(depth);
+        f.ceiling = std::numeric_limits<float>::infinity();
+        const glm::vec3 n = decode_normal(p.normal);
+        // Too steep floors are remembered as not walkable by a NaN height
+        // until the ceiling is known, then dropped.
+        if (n[data.up] < data.min_normal_up) f.height = std::numeric_limits<float>::quiet_NaN();
+        tile.floors.push_back(f);
+        open_floor = true;
+      }
+    }
+    // Drop steep floors and those without room for the agent.
+    auto first = tile.floors.begin() + std::ptrdiff_t(column_start);
+    tile.floors.erase(std::remove_if(first, tile.floors.end(),
+                                     [&](const NavFloor& f) {
+                                       return std::isnan(f.height) ||
+                                              f.ceiling - f.height < data.height_cells;
+                                     }),
+                      tile.floors.end());
+  }
+  tile.column_first[size_t(c * c)] = uint16_t(tile.floors.size());
+  if (tile.floors.empty()) tile.column_first.clear();
+}
+
+// ---- links -----------------------------------------------------------------
+
+namespace {
+
+uint8_t best_link(const NavData& data, const NavFloor& f, std::span<const NavFloor> column) {
+  uint8_t best = kNoLink;
+  float best_step = 0.0f;
+  for (size_t j = 0; j < column.size(); ++j) {
+    const NavFloor& g = column[j];
+    const float step = std::fabs(g.height - f.height);
+    if (step > data.climb_cells) continue;
+    const float gap = std::min(f.ceiling, g.ceiling) - std::max(f.height, g.height);
+    if (gap < data.height_cells) continue;
+    if (best == kNoLink || step < best_step) {
+      best = uint8_t(j);
+      best_step = step;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+void link_tile(const NavData& data, NavTile& tile) {
+  if (tile.empty()) return;
+  const int c = data.chunk_size;
+  const glm::ivec2 base = tile.coord * c;
+  for (int lv = 0; lv < c; ++lv) {
+    for (int lu = 0; lu < c; ++lu) {
+      const int ray = lv * c + lu;
+      for (uint32_t i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
+        NavFloor& f = tile.floors[i];
+        for (int d = 0; d < 4; ++d) {
+          f.link[d] = best_link(data, f, data.column(base + glm::ivec2(lu, lv) + kDirStep[d]));
+        }
+      }
+    }
+  }
+}
+
+// ---- erosion ---------------------------------------------------------------
+
+namespace {
+
+// The columns around a tile, within the erosion reach, with their floors
+// numbered consecutively so distances fit in one array.
+struct ErosionWindow {
+  glm::ivec2 lo{0};
+  int size = 0;
+  std::vector<uint32_t> first;            // per window column, into the floor numbering
+  std::vector<const NavFloor*> floors;    // per window column, its floors (or nullptr)
+
+  int column_index(const glm::ivec2& col) const {
+    const glm::ivec2 w = col - lo;
+    if (w.x < 0 || w.y < 0 || w.x >= size || w.y >= size) return -1;
+    return w.y * size + w.x;
+  }
+};
+
+ErosionWindow make_window(const NavData& data, const NavTile& tile) {
+  ErosionWindow w;
+  w.lo = tile.coord * data.chunk_size - glm::ivec2(data.erode_cells);
+  w.size = data.chunk_size + 2 * data.erode_cells;
+  w.first.assign(size_t(w.size * w.size + 1), 0);
+  w.floors.assign(size_t(w.size * w.size), nullptr);
+  uint32_t count = 0;
+  for (int y = 0; y < w.size; ++y) {
+    for (int x = 0; x < w.size; ++x) {
+      const int i = y * w.size + x;
+      w.first[size_t(i)] = count;
+      std::span<const NavFloor> col = data.column(w.lo + glm::ivec2(x, y));
+      if (!col.empty()) w.floors[size_t(i)] = col.data();
+      count += uint32_t(col.size());
+    }
+  }
+  w.first.back() = count;
+  return w;
+}
+
+}  // namespace
+
+// Chamfer distance (2 along a side, 3 across a corner, in half cells, as
+// Recast's rcErodeWalkableArea) from every floor to the nearest floor that
+// misses one of its four links; floors nearer than 2 * erode_cells go.
+void erode_tile(const NavData& data, NavTile& tile) {
+  if (tile.empty()) return;
+  const int limit = 2 * data.erode_cells;
+  if (limit == 0) {
+    for (NavFloor& f : tile.floors) f.kept = true;
+    return;
+  }
+  const ErosionWindow w = make_window(data, tile);
+  const uint32_t total = w.first.back();
+  std::vector<uint8_t> dist(total, uint8_t(limit));
+  std::vector<std::vector<uint32_t>> buckets(static_cast<size_t>(limit));
+  // Each entry: window column index and floor index in that column, packed.
+  auto pack = [&](int col, int floor) { return uint32_t(col) << 8 | uint32_t(floor); };
+  for (int col = 0; col < w.size * w.size; ++col) {
+    const uint32_t n = w.first[size_t(col) + 1] - w.first[size_t(col)];
+    for (uint32_t k = 0; k < n; ++k) {
+      const NavFloor& f = w.floors[size_t(col)][k];
+      const bool border = f.link[0] == kNoLink || f.link[1] == kNoLink ||
+                          f.link[2] == kNoLink || f.link[3] == kNoLink;
+      if (border) {
+        dist[w.first[size_t(col)] + k] = 0;
+        buckets[0].push_back(pack(col, int(k)));
+      }
+    }
+  }
+  auto relax = [&](int col, int floor, int d) {
+    if (col < 0 || d >= limit) return;
+    uint8_t& slot = dist[w.first[size_t(col)] + uint32_t(floor)];
+    if (d < slot) {
+      slot = uint8_t(d);
+      buckets[size_t(d)].push_back(pack(col, floor));
+    }
+  };
+  for (int d = 0; d < limit; ++d) {
+    for (size_t q = 0; q < buckets[size_t(d)].size(); ++q) {
+      const uint32_t e = buckets[size_t(d)][q];
+      const int col = int(e >> 8), floor = int(e & 0xFF);
+      if (dist[w.first[size_t(col)] + uint32_t(floor)] != d) continue;  // stale
+      const glm::ivec2 at = w.lo + glm::ivec2(col % w.size, col / w.size);
+      const NavFloor& f = w.floors[size_t(col)][floor];
+      for (int s = 0; s < 4; ++s) {
+        if (f.link[s] == kNoLink) continue;
+        const glm::ivec2 side = at + kDirStep[s];
+        const int side_col = w.column_index(side);
+        relax(side_col, f.link[s], d + 2);
+        if (side_col < 0) continue;
+        // Across the corner: the side neighbour, then a quarter turn.
+        const NavFloor& g = w.floors[size_t(side_col)][f.link[s]];
+        const int t = (s + 1) & 3;
+        if (g.link[t] != kNoLink) relax(w.column_index(side + kDirStep[t]), g.link[t], d + 3);
+      }
+    }
+  }
+  const glm::ivec2 own = tile.coord * data.chunk_size - w.lo;
+  const int c = data.chunk_size;
+  for (int lv = 0; lv < c; ++lv) {
+    for (int lu = 0; lu < c; ++lu) {
+      const int ray = lv * c + lu;
+      const int col = (own.y + lv) * w.size + own.x + lu;
+      for (uint32_t i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
+        const uint32_t k = i - tile.column_first[size_t(ray)];
+        tile.floors[i].kept = dist[w.first[size_t(col)] + k] >= limit;
+      }
+    }
+  }
+}
+
+// ---- rectangles ------------------------------------------------------------
+
+namespace {
+
+struct TileFloors {
+  const NavData& data;
+  NavTile& tile;
+  // Index of floor `level` of local column (lu, lv) in tile.floors, or -1.
+  int at(int lu, int lv, int level) const {
+    const int c = data.chunk_size;
+    if (lu < 0 || lv < 0 || lu >= c || lv >= c || level == kNoLink) return -1;
+    const int ray = lv * c + lu;
+    const int i = tile.column_first[size_t(ray)] + level;
+    return i < tile.column_first[size_t(ray) + 1] ? i : -1;
+  }
+  int level_of(int lu, int lv, int index) const {
+    return index - tile.column_first[size_t(lv * data.chunk_size + lu)];
+  }
+  // The free kept floor linked (both ways) from floor i at (lu, lv) in direction d, or -1.
+  int free_neighbour(int lu, int lv, int i, int d) const {
+    const NavFloor& f = tile.floors[size_t(i)];
+    const int nu = lu + kDirStep[d].x, nv = lv + kDirStep[d].y;
+    const int j = at(nu, nv, f.link[d]);
+    if (j < 0) return -1;
+    const NavFloor& g = tile.floors[size_t(j)];
+    if (!g.kept || g.region != kNoRegion) return -1;
+    if (g.link[opposite(d)] != level_of(lu, lv, i)) return -1;
+    return j;
+  }
+};
+
+}  // namespace
+
+void cover_tile(const NavData& data, NavTile& tile) {
+  tile.regions.clear();
+  tile.portals.clear();
+  if (tile.empty()) return;
+  for (NavFloor& f : tile.floors) f.region = kNoRegion;
+  const int c = data.chunk_size;
+  const TileFloors tf{data, tile};
+  const glm::ivec2 base = tile.coord * c;
+  std::vector<int> row, next;
+  for (int lv = 0; lv < c; ++lv) {
+    for (int lu = 0; lu < c; ++lu) {
+      const int ray = lv * c + lu;
+      for (int i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
+        if (!tile.floors[size_t(i)].kept || tile.floors[size_t(i)].region != kNoRegion) continue;
+        const uint16_t id = uint16_t(tile.regions.size());
+        // Grow along +u.
+        row.assign(1, i);
+        tile.floors[size_t(i)].region = id;
+        for (int u = lu; ; ++u) {
+          const int j = tf.free_neighbour(u, lv, row.back(), 0);
+          if (j < 0) break;
+          tile.floors[size_t(j)].region = id;
+          row.push_back(j);
+        }
+        // Grow along +v while the whole next row is free, linked upward and along.
+        int rows = 1;
+        for (int v = lv; v + 1 < c; ++v) {
+          next.clear();
+          for (size_t k = 0; k < row.size(); ++k) {
+            const int j = tf.free_neighbour(lu + int(k), v, row[k], 1);
+            if (j < 0) break;
+            if (k > 0) {  // the new row's floors must be linked to each other
+              const NavFloor& prev = tile.floors[size_t(next.back())];
+              if (tf.at(lu + int(k), v + 1, prev.link[0]) != j) break;
+              if (tile.floors[size_t(j)].link[2] != tf.level_of(lu + int(k) - 1, v + 1, next.back())) break;
+            }
+            next.push_back(j);
+          }
+          if (next.size() != row.size()) break;
+          for (int j : next) tile.floors[size_t(j)].region = id;
+          row = next;
+          ++rows;
+        }
+        NavRegion r;
+        r.lo = base + glm::ivec2(lu, lv);
+        r.hi = r.lo + glm::ivec2(int(row.size()) - 1, rows - 1);
+        tile.regions.push_back(r);
+      }
+    }
+  }
+  // Height range of each region.
+  for (NavRegion& r : tile.regions) {
+    r.height_min = std::numeric_limits<float>::infinity();
+    r.height_max = -std::numeric_limits<float>::infinity();
+  }
+  for (const NavFloor& f : tile.floors) {
+    if (f.region == kNoRegion) continue;
+    NavRegion& r = tile.regions[f.region];
+    r.height_min = std::min(r.height_min, f.height);
+    r.height_max = std::max(r.height_max, f.height);
+  }
+}
+
+// ---- portals ---------------------------------------------------------------
+
+namespace {
+
+// The floor of region `id` in a column of its rectangle.
+const NavFloor* region_floor(const NavData& data, const glm::ivec2& col, uint16_t id) {
+  for (const NavFloor& f : data.column(col)) {
+    if (f.region == id && f.kept) return &f;
+  }
+  return nullptr;
+}
+
+struct PortalRun {
+  bool open = false;
+  uint32_t tile = 0;
+  uint16_t region = 0;
+  glm::ivec2 first{0}, last{0};
+  float height_first = 0.0f, height_last = 0.0f;
+};
+
+}  // namespace
+
+void connect_tile(const NavData& data, NavTile& tile) {
+  tile.portals.clear();
+  for (uint16_t id = 0; id < tile.regions.size(); ++id) {
+    NavRegion& r = tile.regions[id];
+    r.first_portal = uint32_t(tile.portals.size());
+    for (int d = 0; d < 4; ++d) {
+      // Columns along side d, in increasing order of the other coordinate.
+      const int along = (d == 0 || d == 2) ? 1 : 0;  // coordinate that varies
+      glm::ivec2 col = (d == 0 || d == 1) ? r.hi : r.lo;
+      const int from = r.lo[along], to = r.hi[along];
+      PortalRun run;
+      auto close = [&]() {
+        if (!run.open) return;
+        NavPortal p;
+        p.to_tile = run.tile;
+        p.to_region = run.region;
+        p.dir = uint8_t(d);
+        // The side lies half a cell out from the columns, the run's ends half a cell beyond.
+        const glm::vec2 out = glm::vec2(kDirStep[d]) * 0.5f;
+        glm::vec2 a = glm::vec2(run.first) + out, b = glm::vec2(run.last) + out;
+        a[along] -= 0.5f;
+        b[along] += 0.5f;
+        p.a = a;
+        p.b = b;
+        p.height_a = run.height_first;
+        p.height_b = run.height_last;
+        tile.portals.push_back(p);
+        run.open = false;
+      };
+      for (int k = from; k <= to; ++k) {
+        col[along] = k;
+        const NavFloor* f = region_floor(data, col, id);
+        const glm::ivec2 other = col + kDirStep[d];
+        int other_slot = 0;
+        const int other_index = f ? data.column_first(other, &other_slot) : -1;
+        const NavFloor* g = nullptr;
+        if (other_index >= 0 && f->link[d] != kNoLink) {
+          const NavTile& ot = data.tiles[size_t(other_slot)];
+          const uint32_t gi = ot.column_first[size_t(other_index)] + f->link[d];
+          if (gi < ot.column_first[size_t(other_index) + 1]) g = &ot.floors[gi];
+        }
+        if (!g || !g->kept || g->region == kNoRegion) {
+          close();
+          continue;
+        }
+        const float hh = 0.5f * (f->height + g->height);
+        if (run.open && (run.tile != uint32_t(other_slot) || run.region != g->region)) close();
+        if (!run.open) {
+          run = {true, uint32_t(other_slot), g->region, col, col, hh, hh};
+        } else {
+          run.last = col;
+          run.height_last = hh;
+        }
+      }
+      close();
+    }
+    r.portal_count = uint32_t(tile.portals.size()) - r.first_portal;
+  }
+}
+
+// ---- components ------------------------------------------------------------
+
+namespace {
+
+uint32_t find_root(std::vector<uint32_t>& parent, uint32_t x) {
+  while (parent[x] != x) {
+    parent[x] = parent[parent[x]];
+    x = parent[x];
+  }
+  return x;
+}
+
+}  // namespace
+
+void relabel(NavData& data) {
+  uint32_t count = 0, floors = 0;
+  data.dense_tile.clear();
+  for (uint32_t s = 0; s < data.tiles.size(); ++s) {
+    NavTile& t = data.tiles[s];
+    t.dense_first = count;
+    t.dense_floor_first = floors;
+    floors += uint32_t(t.floors.size());
+    count += uint32_t(t.regions.size());
+    data.dense_tile.insert(data.dense_tile.end(), t.regions.size(), s);
+  }
+  data.dense_count = count;
+  data.dense_floor_count = floors;
+  std::vector<uint32_t> parent(count);
+  std::iota(parent.begin(), parent.end(), 0u);
+  for (const NavTile& t : data.tiles) {
+    for (uint32_t r = 0; r < t.regions.size(); ++r) {
+      const NavRegion& reg = t.regions[r];
+      for (uint32_t k = 0; k < reg.portal_count; ++k) {
+        const NavPortal& p = t.portals[reg.first_portal + k];
+        const uint32_t a = find_root(parent, t.dense_first + r);
+        const uint32_t b = find_root(parent, data.tiles[p.to_tile].dense_first + p.to_region);
+        if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      }
+    }
+  }
+  std::vector<uint32_t> label(count, UINT32_MAX);
+  uint32_t components = 0;
+  for (NavTile& t : data.tiles) {
+    for (uint32_t r = 0; r < t.regions.size(); ++r) {
+      const uint32_t root = find_root(parent, t.dense_first + r);
+      if (label[root] == UINT32_MAX) label[root] = components++;
+      t.regions[r].component = label[root];
+    }
+  }
+  data.component_count = components;
+}
+
+}  // namespace ldc::detail
