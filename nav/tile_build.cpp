@@ -1,6 +1,7 @@
 // Building one tile: floors from the vertical rays, links to the neighbour
 // columns, erosion by the agent radius, rectangles, portals.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -125,19 +126,16 @@ void extract_tile(const NavData& data, const World& world, NavTile& tile) {
         f.height = float(depth);
         f.ceiling = std::numeric_limits<float>::infinity();
         const glm::vec3 n = decode_normal(p.normal);
-        // Too steep floors are remembered as not walkable by a NaN height
-        // until the ceiling is known, then dropped.
-        if (n[data.up] < data.min_normal_up) f.height = std::numeric_limits<float>::quiet_NaN();
+        if (n[data.up] < data.min_normal_up) f.flags |= kSteepNormal;
         tile.floors.push_back(f);
         open_floor = true;
       }
     }
-    // Drop steep floors and those without room for the agent.
+    // Drop floors without room for the agent.
     auto first = tile.floors.begin() + std::ptrdiff_t(column_start);
     tile.floors.erase(std::remove_if(first, tile.floors.end(),
                                      [&](const NavFloor& f) {
-                                       return std::isnan(f.height) ||
-                                              f.ceiling - f.height < data.height_cells;
+                                       return f.ceiling - f.height < data.height_cells;
                                      }),
                       tile.floors.end());
   }
@@ -166,6 +164,20 @@ uint8_t best_link(const NavData& data, const NavFloor& f, std::span<const NavFlo
   return best;
 }
 
+// Walkable when the stored normal is, or when a linked neighbour's is: the
+// column stands for an h x h square, and like a navmesh cell (which takes
+// the flattest triangle within max_climb of its top) it is walkable when
+// walkable ground touches it. Creases and small steps one or two cells wide
+// whose point normals are steep are stepped over; a steep ramp or cliff
+// stays closed beyond its first cell.
+bool slope_walkable(const NavFloor& f, const std::array<const NavFloor*, 4>& side) {
+  if (!(f.flags & kSteepNormal)) return true;
+  for (const NavFloor* g : side) {
+    if (g && !(g->flags & kSteepNormal)) return true;
+  }
+  return false;
+}
+
 }  // namespace
 
 void link_tile(const NavData& data, NavTile& tile) {
@@ -177,9 +189,14 @@ void link_tile(const NavData& data, NavTile& tile) {
       const int ray = lv * c + lu;
       for (uint32_t i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
         NavFloor& f = tile.floors[i];
+        std::array<const NavFloor*, 4> side{};
         for (int d = 0; d < 4; ++d) {
-          f.link[d] = best_link(data, f, data.column(base + glm::ivec2(lu, lv) + kDirStep[d]));
+          std::span<const NavFloor> col = data.column(base + glm::ivec2(lu, lv) + kDirStep[d]);
+          f.link[d] = best_link(data, f, col);
+          if (f.link[d] != kNoLink) side[size_t(d)] = &col[f.link[d]];
         }
+        f.flags &= uint8_t(~kWalkable);
+        if (slope_walkable(f, side)) f.flags |= kWalkable;
       }
     }
   }
@@ -227,31 +244,44 @@ ErosionWindow make_window(const NavData& data, const NavTile& tile) {
 }  // namespace
 
 // Chamfer distance (2 along a side, 3 across a corner, in half cells, as
-// Recast's rcErodeWalkableArea) from every floor to the nearest floor that
-// misses one of its four links; floors nearer than 2 * erode_cells go.
+// Recast's rcErodeWalkableArea) from every walkable floor to the nearest one
+// that misses a link to a walkable floor on one of its four sides; floors
+// nearer than 2 * erode_cells go. Floors too steep are not nodes at all.
 void erode_tile(const NavData& data, NavTile& tile) {
   if (tile.empty()) return;
   const int limit = 2 * data.erode_cells;
   if (limit == 0) {
-    for (NavFloor& f : tile.floors) f.kept = true;
+    for (NavFloor& f : tile.floors) f.kept = f.flags & kWalkable;
     return;
   }
   const ErosionWindow w = make_window(data, tile);
-  const uint32_t total = w.first.back();
-  std::vector<uint8_t> dist(total, uint8_t(limit));
+  std::vector<uint8_t> dist(w.first.back(), uint8_t(limit));
   std::vector<std::vector<uint32_t>> buckets(static_cast<size_t>(limit));
-  // Each entry: window column index and floor index in that column, packed.
-  auto pack = [&](int col, int floor) { return uint32_t(col) << 8 | uint32_t(floor); };
+  // Each queue entry: window column index and floor index in that column.
+  auto pack = [](int col, int floor) { return uint32_t(col) << 8 | uint32_t(floor); };
+  auto floor_at = [&](int col, int k) -> const NavFloor& { return w.floors[size_t(col)][k]; };
+  // The walkable floor linked from f (at window column col) towards s: its
+  // window column and index, or col = -1.
+  auto walkable_side = [&](int col, const NavFloor& f, int s) -> std::pair<int, int> {
+    if (f.link[s] == kNoLink) return {-1, 0};
+    const glm::ivec2 at = w.lo + glm::ivec2(col % w.size, col / w.size) + kDirStep[s];
+    const int side = w.column_index(at);
+    if (side < 0) {  // beyond the window: only its linked-ness matters (it is not updated)
+      const std::span<const NavFloor> c = data.column(at);
+      return {(c[f.link[s]].flags & kWalkable) ? -2 : -1, f.link[s]};
+    }
+    if (!(floor_at(side, f.link[s]).flags & kWalkable)) return {-1, 0};
+    return {side, f.link[s]};
+  };
   for (int col = 0; col < w.size * w.size; ++col) {
     const uint32_t n = w.first[size_t(col) + 1] - w.first[size_t(col)];
     for (uint32_t k = 0; k < n; ++k) {
-      const NavFloor& f = w.floors[size_t(col)][k];
-      const bool border = f.link[0] == kNoLink || f.link[1] == kNoLink ||
-                          f.link[2] == kNoLink || f.link[3] == kNoLink;
-      if (border) {
-        dist[w.first[size_t(col)] + k] = 0;
-        buckets[0].push_back(pack(col, int(k)));
-      }
+      const NavFloor& f = floor_at(col, int(k));
+      bool border = !(f.flags & kWalkable);  // not a node: 0, never queued below
+      for (int s = 0; s < 4 && !border; ++s) border = walkable_side(col, f, s).first == -1;
+      if (!border) continue;
+      dist[w.first[size_t(col)] + k] = 0;
+      if (f.flags & kWalkable) buckets[0].push_back(pack(col, int(k)));
     }
   }
   auto relax = [&](int col, int floor, int d) {
@@ -267,18 +297,14 @@ void erode_tile(const NavData& data, NavTile& tile) {
       const uint32_t e = buckets[size_t(d)][q];
       const int col = int(e >> 8), floor = int(e & 0xFF);
       if (dist[w.first[size_t(col)] + uint32_t(floor)] != d) continue;  // stale
-      const glm::ivec2 at = w.lo + glm::ivec2(col % w.size, col / w.size);
-      const NavFloor& f = w.floors[size_t(col)][floor];
+      const NavFloor& f = floor_at(col, floor);
       for (int s = 0; s < 4; ++s) {
-        if (f.link[s] == kNoLink) continue;
-        const glm::ivec2 side = at + kDirStep[s];
-        const int side_col = w.column_index(side);
-        relax(side_col, f.link[s], d + 2);
-        if (side_col < 0) continue;
+        const auto [side, k] = walkable_side(col, f, s);
+        if (side < 0) continue;
+        relax(side, k, d + 2);
         // Across the corner: the side neighbour, then a quarter turn.
-        const NavFloor& g = w.floors[size_t(side_col)][f.link[s]];
-        const int t = (s + 1) & 3;
-        if (g.link[t] != kNoLink) relax(w.column_index(side + kDirStep[t]), g.link[t], d + 3);
+        const auto [corner, kc] = walkable_side(side, floor_at(side, k), (s + 1) & 3);
+        relax(corner, kc, d + 3);
       }
     }
   }
@@ -290,7 +316,7 @@ void erode_tile(const NavData& data, NavTile& tile) {
       const int col = (own.y + lv) * w.size + own.x + lu;
       for (uint32_t i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
         const uint32_t k = i - tile.column_first[size_t(ray)];
-        tile.floors[i].kept = dist[w.first[size_t(col)] + k] >= limit;
+        tile.floors[i].kept = (tile.floors[i].flags & kWalkable) && dist[w.first[size_t(col)] + k] >= limit;
       }
     }
   }

@@ -26,13 +26,17 @@ inline constexpr size_t kMaxTileFloors = 65000;
 inline constexpr glm::ivec2 kDirStep[4] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
 inline constexpr int opposite(int dir) { return (dir + 2) & 3; }
 
-// One floor: the top of a solid span with a walkable slope and enough room above.
+inline constexpr uint8_t kSteepNormal = 1;  // the stored normal is steeper than max_slope
+inline constexpr uint8_t kWalkable = 2;     // the slope over the neighbours is within max_slope
+
+// One floor: the top of a solid span with enough room above. Whether its
+// slope is walkable is decided once its neighbours are linked (kWalkable).
 struct NavFloor {
   float height = 0.0f;   // depth of the floor along up [Units: cells]
   float ceiling = 0.0f;  // depth of the next solid above, or +inf
   uint8_t link[4] = {kNoLink, kNoLink, kNoLink, kNoLink};  // floor index in the neighbour column
-  bool kept = false;     // survived erosion
-  uint8_t pad = 0;
+  bool kept = false;     // walkable and survived erosion
+  uint8_t flags = 0;     // kSteepNormal, kWalkable
   uint16_t region = kNoRegion;  // rectangle (local to the tile) holding it
 };
 
@@ -126,7 +130,11 @@ void setup_nav_data(NavData& data, const World& world, const NavConfig& config);
 // and to the neighbours' floors are left for link_tile().
 void extract_tile(const NavData& data, const World& world, NavTile& tile);
 // Links every floor of the tile to its neighbour columns' floors (neighbour
-// tiles must be extracted).
+// tiles must be extracted) and decides whether its slope is walkable: by its
+// stored normal, or by a linked neighbour's (see slope_walkable). Point
+// normals see every ripple finer than a cell: on the default landscape, thin
+// creases of steep normals alone split the walkable ground into many more
+// islands than a navmesh of the contoured mesh has.
 void link_tile(const NavData& data, NavTile& tile);
 // Erosion (needs the neighbours linked), then rectangles.
 void erode_tile(const NavData& data, NavTile& tile);
