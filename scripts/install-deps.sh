@@ -15,8 +15,8 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   # tests, fuzzing, benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
-  # benchmark peers (Embree: also the ray-cast agreement tests)
-  libopenvdb-dev libboost-iostreams-dev libembree-dev
+  # benchmark peers (Embree: also the ray-cast agreement tests; Recast/Detour: bench_nav)
+  libopenvdb-dev libboost-iostreams-dev libembree-dev librecast-dev
 )
 
 SUDO=""

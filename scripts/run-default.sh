@@ -5,10 +5,11 @@
 # (scripts/default-tunnel.json): the landscape is contoured once, each edit
 # re-meshes only what it changed, and the result is written as out/tunnel.ldc
 # and the re-meshed out/tunnel.glb, with per-edit times and the quality report.
-# Last, `ldc render` draws the dug landscape from the south-east as
-# out/tunnel.png (one ray cast per pixel, with shadows), with the tunnel's
-# centre line (scripts/default-tunnel-path.json) on top: dashed where the
-# ground hides it, solid at the exit (docs/images/default-landscape.png is a copy).
+# Then `ldc path` finds a walking path (agent 2 m tall, 0.6 m radius) from the
+# tunnel's east mouth through the tunnel into the dug chamber (out/path.json),
+# and `ldc render` draws the dug landscape from the south-east as
+# out/tunnel.png (one ray cast per pixel, with shadows) with that path on top:
+# dashed where the ground hides it (docs/images/default-landscape.png is a copy).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -18,5 +19,6 @@ mkdir -p out
 ./build/tools/ldc info out/default.ldc
 ./build/tools/ldc edit out/default.ldc --script scripts/default-tunnel.json -o out/tunnel.ldc \
   --validate --mesh out/tunnel.glb
+./build/tools/ldc path out/tunnel.ldc --from 47,10,2 --to 24,7.5,2 -o out/path.json
 ./build/tools/ldc render out/tunnel.ldc -o out/tunnel.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
-  --width 960 --height 540 --shadows --overlay scripts/default-tunnel-path.json
+  --width 960 --height 540 --shadows --overlay out/path.json

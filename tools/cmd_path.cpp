@@ -1,0 +1,161 @@
+// ldc path: a walking path between two points of a world or a mesh level (JSON out).
+#include <cstdio>
+#include <memory>
+
+#include "common.h"
+#include "ldc/detail/vec_text.h"
+#include "ldc/io.h"
+#include "nav/nav.h"
+
+namespace ldc::tool {
+namespace {
+
+const char* const kPathHelp = R"(The input is an .ldc world, or a mesh level (OBJ, PLY, STL, OFF) that is first
+built into an LDC at the navigation cell size (--cell-size). The up axis defaults to z for
+.ldc worlds (the built-in landscape is z up) and to y for meshes (the Recast convention).
+Output (stdout, or -o FILE), drawable with `ldc render --overlay FILE`:
+  {"status": "complete" | "unreachable" | "out_of_nodes", "length": metres,
+   "path": [[x,y,z], ...], "start": [x,y,z], "goal": [x,y,z], "points": [start, goal],
+   "regions", "nodes_searched",
+   "nav": {"floors", "walkable", "regions", "components", "memory_bytes", "build_seconds"},
+   "query_seconds"}
+"unreachable": the goal lies on another walkable island (or has no floor near it); the path
+ends at the start island's point nearest the goal. The exit status is 0 for every status.
+)";
+
+struct PathArgs {
+  std::string input;
+  std::string from, to;
+  std::string output;
+  std::string up = "auto";
+  double cell_size = 0.3;
+  int max_nodes = 65536;
+  NavConfig agent;
+};
+
+bool is_ldc_file(const std::string& path) {
+  return path.size() >= 4 && path.compare(path.size() - 4, 4, ".ldc") == 0;
+}
+
+Result<int> up_axis(const PathArgs& a) {
+  if (a.up == "auto") return is_ldc_file(a.input) ? 2 : 1;
+  if (a.up == "x") return 0;
+  if (a.up == "y") return 1;
+  if (a.up == "z") return 2;
+  return Status(ErrorCode::kInvalidArgument, "--up " + a.up + ": expected x, y, z or auto");
+}
+
+Result<World> load_input(const PathArgs& a, Context* ctx) {
+  if (is_ldc_file(a.input)) return load_world(a.input, {}, ctx);
+  if (!(a.cell_size > 0.0) || !std::isfinite(a.cell_size)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "--cell-size " + std::to_string(a.cell_size) + ": must be a finite number > 0");
+  }
+  Result<TriangleMesh> mesh = load_mesh(a.input);
+  if (!mesh.ok()) return mesh.status();
+  GridConfig grid;
+  grid.cell_size = a.cell_size;
+  return build_from_mesh(mesh.value(), grid, ctx);
+}
+
+nlohmann::json point_json(const glm::dvec3& p) { return {p.x, p.y, p.z}; }
+
+nlohmann::json path_json(const NavPath& path, const NavMesh& nav, double build_seconds,
+                         double query_seconds) {
+  nlohmann::json points = nlohmann::json::array();
+  for (const glm::dvec3& p : path.corners) points.push_back(point_json(p));
+  const NavStats s = nav.stats();
+  return {{"status", path_status_name(path.status)},
+          {"length", path.length},
+          {"path", points},
+          {"start", point_json(path.corners.front())},
+          {"goal", point_json(path.corners.back())},
+          {"points", {point_json(path.corners.front()), point_json(path.corners.back())}},
+          {"regions", path.regions},
+          {"nodes_searched", path.nodes_searched},
+          {"nav", {{"floors", s.floors}, {"walkable", s.walkable}, {"regions", s.regions},
+                   {"components", s.components}, {"memory_bytes", s.memory_bytes},
+                   {"build_seconds", build_seconds}}},
+          {"query_seconds", query_seconds}};
+}
+
+void print_summary(std::FILE* f, const nlohmann::json& j) {
+  std::fprintf(f, "path %s: %.3f m through %zu corners (%zu regions, %zu nodes searched, %.1f us)\n",
+               j["status"].get<std::string>().c_str(), j["length"].get<double>(), j["path"].size(),
+               j["regions"].get<size_t>(), j["nodes_searched"].get<size_t>(),
+               j["query_seconds"].get<double>() * 1e6);
+  std::fprintf(f, "nav: %zu walkable floors, %zu regions, %zu islands, built in %.1f ms\n",
+               j["nav"]["walkable"].get<size_t>(), j["nav"]["regions"].get<size_t>(),
+               j["nav"]["components"].get<size_t>(), j["nav"]["build_seconds"].get<double>() * 1e3);
+}
+
+int run_path(PathArgs a, const CommonOptions& common) {
+  set_thread_count(common.threads);
+  glm::dvec3 from, to;
+  if (!parse_vec3(a.from, &from)) return fail("path", "--from " + a.from + ": expected x,y,z");
+  if (!parse_vec3(a.to, &to)) return fail("path", "--to " + a.to + ": expected x,y,z");
+  Result<int> up = up_axis(a);
+  if (!up.ok()) return fail("path", up.status());
+  a.agent.up_axis = up.value();
+  ProgressBar bar(!common.quiet);
+  Result<World> world = load_input(a, bar.context());
+  if (!world.ok()) return fail("path", world.status());
+  ScopedTimer build_timer(nullptr, "");
+  Result<NavMesh> nav = NavMesh::build(world.value(), a.agent, bar.context());
+  const double build_seconds = build_timer.seconds();
+  bar.finish();
+  if (!nav.ok()) return fail("path", nav.status());
+  NavQuery query(nav.value(), a.max_nodes);
+  PathQueryOptions options;
+  options.search_half_extents = glm::dvec3(2.0);
+  options.search_half_extents[a.agent.up_axis] = 4.0;
+  ScopedTimer query_timer(nullptr, "");
+  Result<NavPath> path = query.find_path(from, to, options);
+  const double query_seconds = query_timer.seconds();
+  if (!path.ok()) return fail("path", path.status());
+  const nlohmann::json out = path_json(path.value(), nav.value(), build_seconds, query_seconds);
+  if (a.output.empty()) {
+    std::printf("%s\n", out.dump(2).c_str());
+    if (!common.json) print_summary(stderr, out);
+    return 0;
+  }
+  std::FILE* f = std::fopen(a.output.c_str(), "wb");
+  if (!f) return fail("path", "-o " + a.output + ": cannot open for writing");
+  const std::string text = out.dump(2) + "\n";
+  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
+  ok = (std::fclose(f) == 0) && ok;
+  if (!ok) return fail("path", "-o " + a.output + ": write failed");
+  if (common.json) {
+    std::printf("%s\n", nlohmann::json{{"ok", true}, {"output", a.output}, {"status", out["status"]},
+                                       {"length", out["length"]}}.dump(2).c_str());
+  } else {
+    print_summary(stdout, out);
+    std::printf("wrote %s\n", a.output.c_str());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_path_command(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<PathArgs>();
+  CLI::App* cmd = app.add_subcommand("path", "Walking path between two points of a world or mesh level (JSON out)");
+  cmd->add_option("input", args->input, ".ldc world or mesh level")->required();
+  cmd->add_option("--from", args->from, "Start x,y,z (m); snapped to the nearest walkable floor")->required();
+  cmd->add_option("--to", args->to, "Goal x,y,z (m)")->required();
+  cmd->add_option("--up", args->up, "Up axis: x, y, z or auto")->capture_default_str();
+  cmd->add_option("--cell-size", args->cell_size, "Navigation cell for mesh input (m)")->capture_default_str();
+  cmd->add_option("--agent-height", args->agent.agent_height, "Free height the agent needs (m)")->capture_default_str();
+  cmd->add_option("--agent-radius", args->agent.agent_radius, "Agent radius: erosion from walls and drops (m)")->capture_default_str();
+  cmd->add_option("--max-climb", args->agent.max_climb, "Highest step between neighbouring floors (m)")->capture_default_str();
+  cmd->add_option("--max-slope", args->agent.max_slope_degrees, "Steepest walkable floor (degrees)")->capture_default_str();
+  cmd->add_option("--max-nodes", args->max_nodes, "A* node budget (regions)")->capture_default_str();
+  cmd->add_option("-o,--output", args->output, "Write the path JSON here instead of stdout");
+  cmd->footer(kPathHelp);
+  cmd->callback([args, &common] {
+    int code = run_path(*args, common);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ldc::tool
