@@ -138,19 +138,24 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
     s.target_region = dense_region(data, *goal);
     s.goal_reachable = true;
   } else {
-    // Unreachable: aim at the start island's point nearest the goal.
+    // Unreachable: aim at the start island's point nearest the goal. Regions
+    // are ranked by the distance to their rectangle and height range (no
+    // floor lookups); the floor is looked up for the nearest only.
     const glm::dvec3 aim = goal ? goal->point : goal_nav;
     double best = std::numeric_limits<double>::infinity();
     for (uint32_t r = 0; r < data.dense_count; ++r) {
-      if (detail::dense_to_region(data, r).component != island) continue;
-      const glm::dvec3 p = detail::nearest_point_of_region(data, r, aim);
-      const double d = glm::length(p - aim);
+      const NavRegion& reg = detail::dense_to_region(data, r);
+      if (reg.component != island) continue;
+      const glm::dvec3 near(std::clamp(aim.x, reg.lo.x - 0.5, reg.hi.x + 0.5),
+                            std::clamp(aim.y, reg.lo.y - 0.5, reg.hi.y + 0.5),
+                            std::clamp(aim.z, double(reg.height_min), double(reg.height_max)));
+      const double d = glm::length(near - aim);
       if (d < best) {
         best = d;
-        s.target = p;
         s.target_region = r;
       }
     }
+    s.target = detail::nearest_point_of_region(data, s.target_region, aim);
     s.goal_reachable = false;
   }
   s.push_start(s.start_region, s.start, glm::length(s.target - s.start));
