@@ -36,6 +36,10 @@ mkdir -p docs
   echo "## Game queries against Embree (issue 5)"
   echo
   ./build/bench/bench_query
+  echo
+  echo "## Pathfinding against Recast/Detour (issue 6)"
+  echo
+  ./build/bench/bench_nav
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"
