@@ -79,6 +79,13 @@ Status check_extents(const glm::dvec3& half) {
   return {};
 }
 
+Status check_path_input(const glm::dvec3& from, const glm::dvec3& to,
+                        const PathQueryOptions& options) {
+  if (!detail::is_finite(from)) return not_finite("path start", from);
+  if (!detail::is_finite(to)) return not_finite("path goal", to);
+  return check_extents(options.search_half_extents);
+}
+
 uint32_t dense_region(const NavData& data, const detail::FloorHit& hit) {
   const NavTile& t = data.tiles[size_t(hit.tile)];
   return t.dense_first + t.floors[hit.floor].region;
@@ -116,9 +123,7 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
                             const PathQueryOptions& options) {
   detail::NavSearch& s = *search_;
   s.active = false;
-  if (!detail::is_finite(from)) return not_finite("path start", from);
-  if (!detail::is_finite(to)) return not_finite("path goal", to);
-  if (Status st = check_extents(options.search_half_extents); !st.ok()) return st;
+  if (Status st = check_path_input(from, to, options); !st.ok()) return st;
   const NavData& data = *mesh_.data_;
   const glm::dvec3 reach = to_nav_extent(data, options.search_half_extents);
   const auto start = detail::nearest_floor(data, data.to_nav(from), reach);
@@ -198,9 +203,7 @@ Result<NavPath> NavQuery::find_path(const glm::dvec3& from, const glm::dvec3& to
 
 Result<NavPath> NavQuery::find_grid_path(const glm::dvec3& from, const glm::dvec3& to,
                                          const PathQueryOptions& options) {
-  if (!detail::is_finite(from)) return not_finite("path start", from);
-  if (!detail::is_finite(to)) return not_finite("path goal", to);
-  if (Status st = check_extents(options.search_half_extents); !st.ok()) return st;
+  if (Status st = check_path_input(from, to, options); !st.ok()) return st;
   const NavData& data = *mesh_.data_;
   const glm::dvec3 reach = to_nav_extent(data, options.search_half_extents);
   const auto start = detail::nearest_floor(data, data.to_nav(from), reach);
