@@ -177,6 +177,7 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
   QueryStats ours, theirs, grid;
   int agree = 0, no_floor = 0;
   std::vector<double> ratios;
+  std::vector<double> ours_both, theirs_both;  // query times on pairs both complete
   for (const ldc::bench::DetourPair& pair : pairs) {
     const glm::dvec3 a = scene.frame.from_detour(pair.start), b = scene.frame.from_detour(pair.goal);
     ldc::bench::DetourPath dp;
@@ -201,6 +202,10 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
     ours.complete += our_complete;
     agree += our_complete == dp.found;
     if (our_complete && dp.found && dp.length > 0.0) ratios.push_back(lp->length / dp.length);
+    if (our_complete && dp.found) {
+      ours_both.push_back(ours.us.back());
+      theirs_both.push_back(theirs.us.back());
+    }
     const auto s = Clock::now();
     ldc::Result<ldc::NavPath> gp = grid_query.find_grid_path(a, b, options);
     grid.us.push_back(us_since(s));
@@ -283,6 +288,10 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
   base.complete = fmt("%.1f%%", 100.0 * grid.complete / n);
   base.agree = base.length = base.rebuild = "—";
   rows.push_back(base);
+  notes.push_back(scene.name + ": on the " + std::to_string(ours_both.size()) +
+                  " pairs both complete, query µs median / p99: ldc " + fmt("%.2f", percentile(ours_both, 0.5)) +
+                  " / " + fmt("%.2f", percentile(ours_both, 0.99)) + ", Detour " +
+                  fmt("%.2f", percentile(theirs_both, 0.5)) + " / " + fmt("%.2f", percentile(theirs_both, 0.99)));
   notes.push_back(scene.name + ": world " + scene.world_source + " in " + fmt("%.0f", scene.world_build_ms) +
                   " ms (not in the build column); " + std::to_string(scene.triangles.tris.size() / 3) +
                   " triangles for Detour; ldc nav " + std::to_string(nstats.floors) + " floors, " +
