@@ -167,10 +167,11 @@ TEST(Occupancy, SameResultOnOneThreadAndMany) {
   Result<VoxelGrid> single = voxelize(w, VoxelConfig{.voxel_size = 0.5}, opt);
   ASSERT_TRUE(many.ok() && single.ok());
   EXPECT_EQ(many.value().occupancy, single.value().occupancy);
+  EXPECT_EQ(many.value().surface, single.value().surface);
   ASSERT_EQ(many.value().surface.size(), single.value().surface.size());
   for (size_t i = 0; i < many.value().surface.size(); ++i) {
     for (int f = 0; f < kFaces; ++f) {
-      ASSERT_EQ(std::memcmp(&many.value().surface[i].faces[size_t(f)], &single.value().surface[i].faces[size_t(f)],
+      ASSERT_EQ(std::memcmp(&many.value().surface_faces[i][size_t(f)], &single.value().surface_faces[i][size_t(f)],
                             sizeof(FaceSample)),
                 0);
     }
@@ -185,7 +186,7 @@ TEST(Occupancy, SurfaceVoxelsAreThePartlyFilledOnes) {
   for (float o : g.value().occupancy) partial += o > 0.0f && o < 1.0f;
   EXPECT_GE(g.value().surface.size(), partial);
   EXPECT_LT(g.value().surface.size(), partial + partial / 2);
-  for (const SurfaceVoxel& s : g.value().surface) EXPECT_GT(g.value().at(s.voxel), 0.0f);
+  for (const glm::ivec3& v : g.value().surface) EXPECT_GT(g.value().at(v), 0.0f);
 }
 
 // --- G-buffer --------------------------------------------------------------------
@@ -460,10 +461,10 @@ TEST(Objects, StaticObjectIsVoxelizedWithItsVolume) {
   const glm::dvec3 e = hi - lo;
   EXPECT_NEAR(g.value().volume(), e.x * e.y * e.z, 0.01 * e.x * e.y * e.z);
   bool saw_material = false;
-  for (const SurfaceVoxel& s : g.value().surface) {
-    if (s.faces[0].flags == kFaceOwn) {
+  for (const VoxelFaces& s : g.value().surface_faces) {
+    if (s[0].flags == kFaceOwn) {
       saw_material = true;
-      EXPECT_LT(glm::length(glm::vec3(s.faces[0].albedo) - default_material_table().materials[2].albedo), 1e-5f);
+      EXPECT_LT(glm::length(glm::vec3(s[0].albedo) - default_material_table().materials[2].albedo), 1e-5f);
     }
   }
   EXPECT_TRUE(saw_material);

@@ -1,5 +1,6 @@
 // Camera-centred cascades: toroidal storage, scrolling, dirty refresh, schedule.
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <chrono>
 #include <cmath>
@@ -29,7 +30,10 @@ int64_t floor_div(int64_t a, int64_t b) {
   return (a % b != 0 && (a < 0) != (b < 0)) ? q - 1 : q;
 }
 
-int wrap(int g, int n) { return int(g - floor_div(g, n) * n); }
+int wrap(int g, int n) {
+  const int r = g % n;
+  return r < 0 ? r + n : r;
+}
 glm::ivec3 wrap(const glm::ivec3& g, int n) { return {wrap(g.x, n), wrap(g.y, n), wrap(g.z, n)}; }
 
 size_t local_index(const glm::ivec3& t, int n) {
@@ -109,6 +113,8 @@ Result<Cascades> Cascades::create(const Lattice& lattice, const CascadeConfig& c
   c.texture_.resize(config.resolution, config.levels);
   const size_t n3 = size_t(config.resolution) * size_t(config.resolution) * size_t(config.resolution);
   c.occupancy_.assign(size_t(config.levels), std::vector<float>(n3, 0.0f));
+  c.own_faces_.assign(size_t(config.levels), std::vector<uint8_t>(n3, 0));
+  c.propagated_faces_.assign(size_t(config.levels), std::vector<uint8_t>(n3, 0));
   c.boxes_.assign(size_t(config.levels), VoxelBox{});
   c.valid_.assign(size_t(config.levels), false);
   c.pending_.resize(size_t(config.levels));
@@ -150,19 +156,55 @@ Status Cascades::object_sources(int level, Context* ctx) {
 
 namespace {
 
-// Writes a resolved block into level k's toroidal storage.
-void store_block(const detail::BlockScratch& b, int level, int n, PackedGBuffer* tex, std::vector<float>* occ) {
+// Index of face 0 of tile coordinate (0, t.y, t.z) of a level: add f * n + t.x.
+size_t row_base(const PackedGBuffer& tex, int level, int ty, int tz) { return tex.texel(0, level, {0, ty, tz}); }
+
+uint8_t unorm8(float x) { return uint8_t(std::clamp(x, 0.0f, 1.0f) * 255.0f + 0.5f); }
+
+// A level's storage besides the textures.
+struct LevelArrays {
+  std::vector<float>* occupancy;
+  std::vector<uint8_t>* own;
+  std::vector<uint8_t>* propagated;
+};
+
+// Writes a resolved block into level k's toroidal storage, row by row and
+// face by face (each face's row is contiguous in the textures but for the
+// wrap).
+void store_block(const detail::BlockScratch& b, int level, int n, PackedGBuffer* tex, const LevelArrays& arrays) {
   const VoxelBox& bb = b.box;
+  const size_t vox = b.voxels();
+  std::array<int, 256> tx{};
+  for (int x = 0; x < bb.dims.x; ++x) tx[size_t(x)] = wrap(bb.lo.x + x, n);
   for (int z = 0; z < bb.dims.z; ++z) {
+    const int tz = wrap(bb.lo.z + z, n);
     for (int y = 0; y < bb.dims.y; ++y) {
+      const int ty = wrap(bb.lo.y + y, n);
+      const size_t row = row_base(*tex, level, ty, tz);
+      const size_t occ_row = local_index({0, ty, tz}, n);
+      const size_t i0 = bb.index(bb.lo + glm::ivec3(0, y, z));
       for (int x = 0; x < bb.dims.x; ++x) {
-        const glm::ivec3 g = bb.lo + glm::ivec3(x, y, z);
-        const glm::ivec3 t = wrap(g, n);
-        const size_t i = bb.index(g);
-        (*occ)[local_index(t, n)] = b.occupancy[i];
-        for (int f = 0; f < kFaces; ++f) {
-          const size_t texel = tex->texel(f, level, t);
-          tex->occupancy[texel] = uint8_t(std::lround(std::clamp(b.coverage[size_t(face_axis(f)) * b.voxels() + i], 0.0f, 1.0f) * 255.0f));
+        const size_t o = occ_row + size_t(tx[size_t(x)]);
+        (*arrays.occupancy)[o] = b.occupancy[i0 + size_t(x)];
+        (*arrays.own)[o] = b.touched[i0 + size_t(x)];
+        (*arrays.propagated)[o] = 0;
+      }
+      uint8_t row_faces = 0;  // faces with a surface somewhere in this row
+      for (int x = 0; x < bb.dims.x; ++x) row_faces = uint8_t(row_faces | b.touched[i0 + size_t(x)]);
+      for (int f = 0; f < kFaces; ++f) {
+        const float* coverage = b.coverage.data() + size_t(face_axis(f)) * vox + i0;
+        const size_t face_row = row + size_t(f * n);
+        for (int x = 0; x < bb.dims.x; ++x) tex->occupancy[face_row + size_t(tx[size_t(x)])] = unorm8(coverage[x]);
+        if (!((row_faces >> f) & 1u) && tx[size_t(bb.dims.x - 1)] == tx[0] + bb.dims.x - 1) {
+          const size_t first = face_row + size_t(tx[0]), count = size_t(bb.dims.x);
+          std::memset(&tex->albedo[first], 0, count * sizeof(uint32_t));
+          std::memset(&tex->normal[first], 0, count * sizeof(uint32_t));
+          std::memset(&tex->emission[first], 0, count * sizeof(uint32_t));
+          continue;
+        }
+        for (int x = 0; x < bb.dims.x; ++x) {
+          const size_t texel = face_row + size_t(tx[size_t(x)]);
+          const size_t i = i0 + size_t(x);
           if (!(b.touched[i] & (1u << f))) {
             tex->albedo[texel] = 0;
             tex->normal[texel] = 0;
@@ -181,36 +223,56 @@ void store_block(const detail::BlockScratch& b, int level, int n, PackedGBuffer*
 
 }  // namespace
 
-// The talk's post-processing on the packed storage, for the voxels of `region` (inside the level box).
-static void propagate_packed(PackedGBuffer* tex, const std::vector<float>& occ, int level, int n, const VoxelBox& box,
+// The talk's post-processing on the packed storage, for the voxels of
+// `region` (inside the level box): a solid voxel's face without a surface of
+// its own takes the neighbour's on that side; stale copies are cleared. Reads
+// the per-voxel face masks, touching texels only where something is copied.
+static void propagate_packed(PackedGBuffer* tex, const LevelArrays& arrays, int level, int n, const VoxelBox& box,
                              const VoxelBox& region) {
+  const std::vector<float>& occ = *arrays.occupancy;
+  const std::vector<uint8_t>& own = *arrays.own;
+  std::vector<uint8_t>& prop = *arrays.propagated;
   tbb::parallel_for(0, region.dims.z, [&](int z) {
     for (int y = 0; y < region.dims.y; ++y) {
+      const glm::ivec3 g0 = region.lo + glm::ivec3(0, y, z);
+      const int ty = wrap(g0.y, n), tz = wrap(g0.z, n);
+      const size_t occ_row = local_index({0, ty, tz}, n);
       for (int x = 0; x < region.dims.x; ++x) {
-        const glm::ivec3 g = region.lo + glm::ivec3(x, y, z);
-        const glm::ivec3 t = wrap(g, n);
-        const bool solid = occ[local_index(t, n)] > 0.0f;
-        for (int f = 0; f < kFaces; ++f) {
-          const size_t mine = tex->texel(f, level, t);
-          const uint32_t alpha = tex->normal[mine] & kAlphaMask;
-          if (alpha == kOwnAlpha) continue;
-          const glm::ivec3 nb = g + face_direction(f);
-          size_t theirs = 0;
-          bool take = solid && box.contains(nb);
-          if (take) {
-            theirs = tex->texel(f, level, wrap(nb, n));
-            take = (tex->normal[theirs] & kAlphaMask) == kOwnAlpha;
+        const glm::ivec3 g = g0 + glm::ivec3(x, 0, 0);
+        const int tx = wrap(g.x, n);
+        const size_t v = occ_row + size_t(tx);
+        const bool solid = occ[v] > 0.0f;
+        if (!solid && prop[v] == 0) continue;
+        uint8_t want = 0;
+        std::array<size_t, kFaces> from{};
+        if (solid) {
+          for (int f = 0; f < kFaces; ++f) {
+            const glm::ivec3 nb = g + face_direction(f);
+            if ((own[v] >> f) & 1u || !box.contains(nb)) continue;
+            const size_t w = local_index(wrap(nb, n), n);
+            if ((own[w] >> f) & 1u) want = uint8_t(want | (1u << f)), from[size_t(f)] = w;
           }
-          if (take) {
+        }
+        const uint8_t change = uint8_t(want | prop[v]);
+        if (change == 0) continue;
+        const size_t row = row_base(*tex, level, ty, tz);
+        for (int f = 0; f < kFaces; ++f) {
+          if (!((change >> f) & 1u)) continue;
+          const size_t mine = row + size_t(f * n + tx);
+          if ((want >> f) & 1u) {
+            const size_t w = from[size_t(f)];
+            const size_t theirs = row_base(*tex, level, int(w / size_t(n)) % n, int(w / size_t(n * n))) +
+                                  size_t(f * n) + w % size_t(n);
             tex->albedo[mine] = tex->albedo[theirs];
             tex->normal[mine] = (tex->normal[theirs] & ~kAlphaMask) | kPropagatedAlpha;
             tex->emission[mine] = tex->emission[theirs];
-          } else if (alpha == kPropagatedAlpha) {
+          } else {
             tex->albedo[mine] = 0;
             tex->normal[mine] = 0;
             tex->emission[mine] = 0;
           }
         }
+        prop[v] = want;
       }
     }
   });
@@ -232,13 +294,14 @@ Status Cascades::voxelize_regions(const World& world, int level, const std::vect
   }
   const int n = config_.resolution;
   const VoxelBox box = boxes_[size_t(level)];
+  const LevelArrays arrays{&occupancy_[size_t(level)], &own_faces_[size_t(level)], &propagated_faces_[size_t(level)]};
   static thread_local detail::BlockPair scratch;  // reused across calls: no allocation per frame
   tbb::enumerable_thread_specific<detail::BlockCounters> counters;
   for (const VoxelBox& region : regions) {
     const std::vector<VoxelBox> blocks = detail::split_blocks(intersect(region, box), kBlockEdge);
     s = detail::for_each_block(blocks, ctx, "cascade", [&](size_t bi) {
       detail::voxelize_sources(land, objects, blocks[bi], true, &scratch, &counters.local());
-      store_block(scratch.land, level, n, &texture_, &occupancy_[size_t(level)]);
+      store_block(scratch.land, level, n, &texture_, arrays);
     });
     if (!s.ok()) return s;
     if (stats) {
@@ -248,7 +311,7 @@ Status Cascades::voxelize_regions(const World& world, int level, const std::vect
   }
   for (const VoxelBox& region : regions) {
     const VoxelBox r = intersect(grow(region, 1), box);
-    if (!r.empty()) propagate_packed(&texture_, occupancy_[size_t(level)], level, n, box, r);
+    if (!r.empty()) propagate_packed(&texture_, arrays, level, n, box, r);
   }
   if (moved) {  // voxels on the box's faces may have lost the neighbour they took faces from
     for (int a = 0; a < 3; ++a) {
@@ -256,7 +319,7 @@ Status Cascades::voxelize_regions(const World& world, int level, const std::vect
         VoxelBox shell = box;
         shell.lo[a] = side ? box.hi()[a] - 1 : box.lo[a];
         shell.dims[a] = 1;
-        propagate_packed(&texture_, occupancy_[size_t(level)], level, n, box, shell);
+        propagate_packed(&texture_, arrays, level, n, box, shell);
       }
     }
   }
@@ -353,6 +416,12 @@ void Cascades::invalidate(std::span<const DirtyChunk> dirty) {
   }
 }
 
+void Cascades::invalidate_level(int level) {
+  if (level < 0 || level >= levels()) return;
+  valid_[size_t(level)] = false;
+  pending_[size_t(level)].clear();
+}
+
 Result<size_t> Cascades::refresh(const World& world, Context* ctx) {
   size_t voxels = 0;
   for (int k = 0; k < levels(); ++k) {
@@ -428,14 +497,15 @@ VoxelGrid Cascades::level_grid(int level) const {
         const glm::ivec3 v = g.box.lo + glm::ivec3(x, y, z);
         const float o = occupancy(level, v);
         g.occupancy[g.box.index(v)] = o;
-        SurfaceVoxel sv;
-        sv.voxel = v;
+        VoxelFaces faces;
         bool own = false;
         for (int f = 0; f < kFaces; ++f) {
-          sv.faces[size_t(f)] = sample(level, f, v);
-          own |= sv.faces[size_t(f)].flags == kFaceOwn;
+          faces[size_t(f)] = sample(level, f, v);
+          own |= faces[size_t(f)].flags == kFaceOwn;
         }
-        if (own || (o > 0.0f && o < 1.0f)) g.surface.push_back(sv);
+        if (!own && !(o > 0.0f && o < 1.0f)) continue;
+        g.surface.push_back(v);
+        g.surface_faces.push_back(faces);
       }
     }
   }

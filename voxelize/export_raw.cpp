@@ -104,13 +104,13 @@ Status save_raw(const VoxelGrid& grid, const std::string& path) {
   w.add("occupancy", "float32", {size_t(d.z), size_t(d.y), size_t(d.x)}, grid.occupancy.data(), grid.occupancy.size());
   std::vector<int32_t> coords;
   coords.reserve(grid.surface.size() * 3);
-  for (const SurfaceVoxel& s : grid.surface) coords.insert(coords.end(), {s.voxel.x, s.voxel.y, s.voxel.z});
+  for (const glm::ivec3& v : grid.surface) coords.insert(coords.end(), {v.x, v.y, v.z});
   w.add("surface_voxels", "int32", {grid.surface.size(), 3}, coords.data(), coords.size());
   if (grid.has_faces) {
     std::vector<float> faces;
     faces.reserve(grid.surface.size() * kFaces * 12);
-    for (const SurfaceVoxel& s : grid.surface) {
-      for (const FaceSample& f : s.faces) {
+    for (const VoxelFaces& s : grid.surface_faces) {
+      for (const FaceSample& f : s) {
         faces.insert(faces.end(), {f.albedo.r, f.albedo.g, f.albedo.b, f.albedo.a, f.normal.x, f.normal.y, f.normal.z,
                                    f.occupancy, f.emission.r, f.emission.g, f.emission.b, float(f.flags)});
       }

@@ -8,8 +8,12 @@
 namespace ldc {
 namespace {
 
-uint32_t unorm8(float x) { return uint32_t(std::lround(std::clamp(double(x), 0.0, 1.0) * 255.0)); }
-uint32_t snorm8(float x) { return uint32_t(uint8_t(int8_t(std::lround(std::clamp(double(x), -1.0, 1.0) * 127.0)))); }
+// Round to nearest (halves away from zero); NaN gives 0.
+uint32_t unorm8(float x) { return x > 0.0f ? uint32_t(std::min(x, 1.0f) * 255.0f + 0.5f) : 0u; }
+uint32_t snorm8(float x) {
+  const float c = x > 0.0f ? std::min(x, 1.0f) : x < 0.0f ? std::max(x, -1.0f) : 0.0f;
+  return uint32_t(uint8_t(int8_t(int(c * 127.0f + (c >= 0.0f ? 0.5f : -0.5f)))));
+}
 float snorm8_value(uint32_t b) { return std::max(-1.0f, float(int8_t(uint8_t(b))) / 127.0f); }
 
 // An unsigned float of 5 exponent bits (bias 15) and `mb` mantissa bits,

@@ -38,10 +38,10 @@ openvdb::FloatGrid::Ptr occupancy_grid(const VoxelGrid& g) {
 void surface_grids(const VoxelGrid& g, openvdb::Vec3SGrid& normal, openvdb::Vec3SGrid& albedo) {
   auto n_acc = normal.getAccessor();
   auto a_acc = albedo.getAccessor();
-  for (const SurfaceVoxel& s : g.surface) {
+  for (size_t i = 0; i < g.surface.size(); ++i) {
     glm::vec3 n(0.0f), a(0.0f);
     float w = 0.0f;
-    for (const FaceSample& f : s.faces) {
+    for (const FaceSample& f : g.surface_faces[i]) {
       if (f.flags != kFaceOwn) continue;
       n += f.albedo.a * f.normal;
       a += f.albedo.a * glm::vec3(f.albedo);
@@ -51,7 +51,7 @@ void surface_grids(const VoxelGrid& g, openvdb::Vec3SGrid& normal, openvdb::Vec3
     const float len = glm::length(n);
     if (len > 0.0f) n /= len;
     a /= w;
-    const openvdb::Coord c(s.voxel.x, s.voxel.y, s.voxel.z);
+    const openvdb::Coord c(g.surface[i].x, g.surface[i].y, g.surface[i].z);
     n_acc.setValue(c, openvdb::Vec3s(n.x, n.y, n.z));
     a_acc.setValue(c, openvdb::Vec3s(a.x, a.y, a.z));
   }

@@ -202,12 +202,6 @@ Status check_box(const VoxelBox& box) {
   return {};
 }
 
-void sort_surface(std::vector<SurfaceVoxel>* s) {
-  std::sort(s->begin(), s->end(), [](const SurfaceVoxel& a, const SurfaceVoxel& b) {
-    return std::tie(a.voxel.z, a.voxel.y, a.voxel.x) < std::tie(b.voxel.z, b.voxel.y, b.voxel.x);
-  });
-}
-
 void add_stats(VoxelStats* stats, const tbb::enumerable_thread_specific<detail::BlockCounters>& counters) {
   if (!stats) return;
   for (const auto& c : counters) {
@@ -246,7 +240,8 @@ Result<VoxelGrid> voxelize(const World& world, const VoxelConfig& config, const 
   grid.occupancy.assign(box.count(), 0.0f);
   const std::vector<VoxelBox> blocks = detail::split_blocks(box, options.faces ? 16 : 32);
   const std::vector<detail::ObjectRef> objects = detail::object_refs(p, materials, config.axis);
-  std::vector<std::vector<SurfaceVoxel>> surface(blocks.size());
+  std::vector<std::vector<glm::ivec3>> surface(blocks.size());
+  std::vector<std::vector<VoxelFaces>> surface_faces(options.faces ? blocks.size() : 0);
   tbb::enumerable_thread_specific<BlockPair> scratch;
   tbb::enumerable_thread_specific<detail::BlockCounters> counters;
   s = detail::for_each_block(blocks, ctx, "voxelize", [&](size_t bi) {
@@ -261,19 +256,18 @@ Result<VoxelGrid> voxelize(const World& world, const VoxelConfig& config, const 
           const size_t i = bb.index(g);
           grid.occupancy[box.index(g)] = b.occupancy[i];
           if (!is_surface(b, i)) continue;
-          SurfaceVoxel sv;
-          sv.voxel = g;
-          if (options.faces) {
-            for (int f = 0; f < kFaces; ++f) sv.faces[size_t(f)] = detail::face_sample(b, i, f);
-          }
-          surface[bi].push_back(sv);
+          surface[bi].push_back(g);
+          if (!options.faces) continue;
+          VoxelFaces faces;
+          for (int f = 0; f < kFaces; ++f) faces[size_t(f)] = detail::face_sample(b, i, f);
+          surface_faces[bi].push_back(faces);
         }
       }
     }
   });
   if (!s.ok()) return s;
   for (auto& v : surface) grid.surface.insert(grid.surface.end(), v.begin(), v.end());
-  sort_surface(&grid.surface);
+  for (auto& v : surface_faces) grid.surface_faces.insert(grid.surface_faces.end(), v.begin(), v.end());
   if (stats) {
     add_stats(stats, counters);
     stats->voxels += box.count();
@@ -365,9 +359,6 @@ Result<GBuffer> voxelize_gbuffer(const World& world, const VoxelConfig& config, 
   if (!s.ok()) return s;
   propagate(&gb);
   for (auto& v : surface) gb.surface.insert(gb.surface.end(), v.begin(), v.end());
-  std::sort(gb.surface.begin(), gb.surface.end(), [](const glm::ivec3& a, const glm::ivec3& b) {
-    return std::tie(a.z, a.y, a.x) < std::tie(b.z, b.y, b.x);
-  });
   if (stats) {
     add_stats(stats, counters);
     stats->voxels += box.count();

@@ -171,10 +171,7 @@ struct FaceSample {
 inline constexpr uint8_t kFaceOwn = 1;         // the face holds a surface point of its own
 inline constexpr uint8_t kFacePropagated = 2;  // copied from the neighbour (first subsurface layer)
 
-struct SurfaceVoxel {
-  glm::ivec3 voxel{0};                 // global voxel coordinates
-  std::array<FaceSample, kFaces> faces;  // filled when the grid was voxelized with faces
-};
+using VoxelFaces = std::array<FaceSample, kFaces>;
 
 // A dense occupancy grid and its surface voxels. Owns its arrays.
 struct VoxelGrid {
@@ -182,8 +179,11 @@ struct VoxelGrid {
   double voxel_size = 0.0;        // [Units: m]
   glm::dvec3 origin{0.0};         // world position of voxel (0,0,0)'s low corner (the lattice origin)
   std::vector<float> occupancy;   // box.count(), x fastest: box.index(g)
-  std::vector<SurfaceVoxel> surface;  // sorted by (z, y, x)
-  bool has_faces = false;         // surface[i].faces filled (VoxelizeOptions::faces)
+  // Surface voxels (global coordinates) in a fixed order (by blocks of
+  // voxels, z, y, x within each), the same for any thread count.
+  std::vector<glm::ivec3> surface;
+  bool has_faces = false;                 // VoxelizeOptions::faces
+  std::vector<VoxelFaces> surface_faces;  // with faces: surface_faces[i] of surface[i]
 
   float at(const glm::ivec3& g) const { return box.contains(g) ? occupancy[box.index(g)] : 0.0f; }
   glm::dvec3 voxel_min(const glm::ivec3& g) const { return origin + voxel_size * glm::dvec3(g); }
@@ -198,7 +198,7 @@ struct GBuffer {
   glm::dvec3 origin{0.0};
   std::vector<float> occupancy;        // box.count(): volume fraction
   std::vector<FaceSample> faces;       // kFaces * box.count(): face f of voxel g at f * count + box.index(g)
-  std::vector<glm::ivec3> surface;     // surface voxels, sorted by (z, y, x)
+  std::vector<glm::ivec3> surface;     // surface voxels, in VoxelGrid::surface's order
 
   const FaceSample& face(int f, const glm::ivec3& g) const { return faces[size_t(f) * box.count() + box.index(g)]; }
 };
@@ -376,6 +376,8 @@ class Cascades {
 
   // Marks the voxels under dirty chunks for refresh at each level's next update.
   void invalidate(std::span<const DirtyChunk> dirty);
+  // Forgets a level's content: its next update voxelizes it whole.
+  void invalidate_level(int level);
   // Re-voxelizes every level's pending dirty voxels now (levels stay put).
   Result<size_t> refresh(const World& world, Context* ctx = nullptr);
 
@@ -411,6 +413,10 @@ class Cascades {
   int base_cells_ = 1;  // m of level 0
   PackedGBuffer texture_;
   std::vector<std::vector<float>> occupancy_;
+  // Per level and voxel (toroidal, as occupancy_): bit f set where face f
+  // holds its own surface / a propagated copy. Lets propagation skip texels.
+  std::vector<std::vector<uint8_t>> own_faces_;
+  std::vector<std::vector<uint8_t>> propagated_faces_;
   std::vector<VoxelBox> boxes_;
   std::vector<bool> valid_;
   std::vector<std::vector<VoxelBox>> pending_;  // per level: dirty voxel boxes

@@ -72,8 +72,8 @@ TEST(Vdb, OccupancyNormalAndAlbedoRoundTripThroughOpenVdb) {
   size_t with_normal = 0;
   auto n_acc = normal->getConstAccessor();
   auto a_acc = albedo->getConstAccessor();
-  for (const SurfaceVoxel& s : g.value().surface) {
-    const openvdb::Coord c(s.voxel.x, s.voxel.y, s.voxel.z);
+  for (const glm::ivec3& v : g.value().surface) {
+    const openvdb::Coord c(v.x, v.y, v.z);
     if (!n_acc.isValueOn(c)) continue;
     ++with_normal;
     EXPECT_NEAR(n_acc.getValue(c).length(), 1.0, 1e-5);
