@@ -320,7 +320,8 @@ void resolve_volume(const VoxelSource& src, BlockScratch& s) {
   const glm::ivec3 step(1, d.x, d.x * d.y);
   const int64_t bin_steps = int64_t(src.m) * int64_t(depth_steps_per_cell(src.world->chunk_size()));
   const int64_t n = s.full_n;
-  const double full = double(4 * n * n * bin_steps);
+  const int64_t full = 4 * n * n * bin_steps;
+  const double inv_full = 1.0 / double(full);
   for (int cv = 0; cv < d[v]; ++cv) {
     for (int cu = 0; cu < d[u]; ++cu) {
       const int64_t* diff = s.volume_diff.data() + size_t(cv * d[u] + cu) * size_t(d[a] + 1);
@@ -329,7 +330,8 @@ void resolve_volume(const VoxelSource& src, BlockScratch& s) {
       for (int b = 0; b < d[a]; ++b) {
         run += diff[b];
         const size_t i = base + size_t(b) * size_t(step[a]);
-        s.occupancy[i] = float(double(s.volume[i] + run * bin_steps) / full);
+        const int64_t v = s.volume[i] + run * bin_steps;
+        s.occupancy[i] = v == full ? 1.0f : float(double(v) * inv_full);  // exactly 1 when full
       }
     }
   }

@@ -3,7 +3,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <cstring>
 #include <mutex>
 #include <sstream>
 
@@ -251,11 +253,13 @@ Result<VoxelGrid> voxelize(const World& world, const VoxelConfig& config, const 
     const VoxelBox& bb = blocks[bi];
     for (int z = 0; z < bb.dims.z; ++z) {
       for (int y = 0; y < bb.dims.y; ++y) {
+        const size_t row = bb.index(bb.lo + glm::ivec3(0, y, z));
+        std::memcpy(&grid.occupancy[box.index(bb.lo + glm::ivec3(0, y, z))], &b.occupancy[row],
+                    size_t(bb.dims.x) * sizeof(float));
         for (int x = 0; x < bb.dims.x; ++x) {
-          const glm::ivec3 g = bb.lo + glm::ivec3(x, y, z);
-          const size_t i = bb.index(g);
-          grid.occupancy[box.index(g)] = b.occupancy[i];
+          const size_t i = row + size_t(x);
           if (!is_surface(b, i)) continue;
+          const glm::ivec3 g = bb.lo + glm::ivec3(x, y, z);
           surface[bi].push_back(g);
           if (!options.faces) continue;
           VoxelFaces faces;
