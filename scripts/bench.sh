@@ -36,6 +36,10 @@ mkdir -p docs
   echo "## Game queries against Embree (issue 5)"
   echo
   ./build/bench/bench_query
+  echo
+  echo "## Voxel export against OpenVDB's solid voxelization (issue 7)"
+  echo
+  ./build/bench/bench_voxelize
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"

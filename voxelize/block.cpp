@@ -366,20 +366,65 @@ int sample_stride(int m, int supersampling) {
 void BlockScratch::reset(const VoxelBox& b, bool with_faces) {
   box = b;
   faces = with_faces;
+  uniform = ChunkKind::kMixed;
   const size_t n = b.count();
-  volume.assign(n, 0);
-  surface.assign(n, 0);
+  volume.resize(n);
+  surface.resize(n);
   occupancy.resize(n);
   if (faces) {
-    touched.assign(n, 0);
+    touched.resize(n);
     face.resize(n * kFaces);
     coverage.resize(3 * n);
   }
 }
 
+namespace {
+
+// Empty or solid when every chunk holding one of the block's nodes [m*lo, m*hi] is so; else kMixed.
+ChunkKind block_kind(const VoxelSource& src, const VoxelBox& box) {
+  const World& w = *src.world;
+  const int c = w.chunk_size();
+  glm::ivec3 c0, c1;
+  for (int a = 0; a < 3; ++a) {
+    c0[a] = int(floor_div(int64_t(src.m) * box.lo[a], c));
+    c1[a] = int(floor_div(int64_t(src.m) * box.hi()[a], c));
+  }
+  const ChunkKind first = w.chunk_kind(c0);
+  if (first == ChunkKind::kMixed) return first;
+  for (int z = c0.z; z <= c1.z; ++z) {
+    for (int y = c0.y; y <= c1.y; ++y) {
+      for (int x = c0.x; x <= c1.x; ++x) {
+        if (w.chunk_kind({x, y, z}) != first) return ChunkKind::kMixed;
+      }
+    }
+  }
+  return first;
+}
+
+void fill_uniform(BlockScratch* s, bool solid) {
+  const size_t n = s->voxels();
+  std::fill(s->occupancy.begin(), s->occupancy.begin() + std::ptrdiff_t(n), solid ? 1.0f : 0.0f);
+  std::fill(s->surface.begin(), s->surface.begin() + std::ptrdiff_t(n), uint8_t{0});
+  if (!s->faces) return;
+  std::fill(s->touched.begin(), s->touched.begin() + std::ptrdiff_t(n), uint8_t{0});
+  std::fill(s->coverage.begin(), s->coverage.begin() + std::ptrdiff_t(3 * n), solid ? 1.0f : 0.0f);
+}
+
+}  // namespace
+
 void voxelize_block(const VoxelSource& source, BlockScratch* s, BlockCounters* counters) {
   assert(source.m % source.stride == 0);
   s->full_n = source.m / source.stride;
+  s->uniform = block_kind(source, s->box);
+  if (s->uniform != ChunkKind::kMixed) {
+    if (counters) ++counters->closed;
+    fill_uniform(s, s->uniform == ChunkKind::kSolid);
+    return;
+  }
+  const size_t vox = s->voxels();
+  std::fill(s->volume.begin(), s->volume.begin() + std::ptrdiff_t(vox), int64_t{0});
+  std::fill(s->surface.begin(), s->surface.begin() + std::ptrdiff_t(vox), uint8_t{0});
+  if (s->faces) std::fill(s->touched.begin(), s->touched.begin() + std::ptrdiff_t(vox), uint8_t{0});
   const glm::ivec3 d = s->box.dims;
   const int a = source.occ_axis;
   s->volume_diff.assign(size_t(d[axis_u(a)]) * size_t(d[axis_v(a)]) * size_t(d[a] + 1), 0);

@@ -256,6 +256,7 @@ Result<VoxelGrid> voxelize(const World& world, const VoxelConfig& config, const 
         const size_t row = bb.index(bb.lo + glm::ivec3(0, y, z));
         std::memcpy(&grid.occupancy[box.index(bb.lo + glm::ivec3(0, y, z))], &b.occupancy[row],
                     size_t(bb.dims.x) * sizeof(float));
+        if (b.uniform != ChunkKind::kMixed) continue;  // no surface in an empty or solid block
         for (int x = 0; x < bb.dims.x; ++x) {
           const size_t i = row + size_t(x);
           if (!is_surface(b, i)) continue;

@@ -50,6 +50,9 @@ struct BlockScratch {
   std::vector<FaceAccum> face;         // face f of voxel i at i * kFaces + f (valid where touched)
   std::vector<float> coverage;         // faces: per axis a and voxel i at a * V + i
   std::vector<float> occupancy;        // per voxel, after the resolve
+  // Set when every chunk the block's rays touch is empty (kEmpty) or solid
+  // (kSolid): the arrays are then filled without reading a ray.
+  ChunkKind uniform = ChunkKind::kMixed;
 
   void reset(const VoxelBox& b, bool with_faces);
   size_t voxels() const { return box.count(); }
