@@ -438,6 +438,7 @@ void voxelize_block(const VoxelSource& source, BlockScratch* s, BlockCounters* c
 
 void combine_blocks(BlockScratch* into, const BlockScratch& other) {
   const size_t vox = into->voxels();
+  if (other.uniform != ChunkKind::kEmpty) into->uniform = ChunkKind::kMixed;  // may hold surface now
   for (size_t i = 0; i < vox; ++i) {
     into->occupancy[i] = std::min(1.0f, into->occupancy[i] + other.occupancy[i]);
     into->surface[i] = uint8_t(into->surface[i] | other.surface[i]);
