@@ -40,6 +40,10 @@ mkdir -p docs
   echo "## Pathfinding against Recast/Detour (issue 6)"
   echo
   ./build/bench/bench_nav
+  echo
+  echo "## Voxel export against OpenVDB's solid voxelization (issue 7)"
+  echo
+  ./build/bench/bench_voxelize
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"

@@ -82,5 +82,6 @@ void add_edit_command(CLI::App& app, CommonOptions& common);
 void add_raycast_command(CLI::App& app, CommonOptions& common);
 void add_render_command(CLI::App& app, CommonOptions& common);
 void add_path_command(CLI::App& app, CommonOptions& common);
+void add_voxelize_command(CLI::App& app, CommonOptions& common);
 
 }  // namespace ldc::tool

@@ -1,0 +1,179 @@
+// ldc voxelize: solid occupancy and the six-face G-buffer of a world -> .vdb, or raw arrays + JSON header.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include "common.h"
+#include "ldc/detail/vec_text.h"
+#include "ldc/io.h"
+#include "voxelize/vdb.h"
+#include "voxelize/voxelize.h"
+
+namespace ldc::tool {
+namespace {
+
+const char* const kVoxelizeHelp = R"(Without --cascades: one dense grid over the world's solid at --voxel-size (a whole
+number of cells h). With --cascades K: K camera-centred levels of N^3 voxels (--resolution, default 32), level k of
+voxel size s * 2^k, around --camera (default: the centre of the solid).
+Output by extension: .vdb (OpenVDB grids occupancy, normal, albedo; per cascade level _L<k>), or .json / .raw
+(both files are written: little-endian arrays in .raw, their names, types, shapes and offsets in .json).)";
+
+struct VoxelizeArgs {
+  std::string world;
+  std::string output;
+  double voxel_size = 0.0;
+  int cascades = 0;
+  int resolution = 32;
+  std::string camera;
+  std::string axis = "z";
+  bool occupancy_only = false;
+};
+
+enum class Format { kVdb, kRaw };
+
+Result<Format> output_format(const std::string& path) {
+  auto ends = [&](const std::string& e) {
+    return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
+  };
+  if (ends(".vdb")) return Format::kVdb;
+  if (ends(".json") || ends(".raw")) return Format::kRaw;
+  return Status(ErrorCode::kInvalidArgument, "-o " + path + ": unknown output format (use .vdb, .json or .raw)");
+}
+
+Result<int> parse_axis(const std::string& a) {
+  if (a == "x") return 0;
+  if (a == "y") return 1;
+  if (a == "z") return 2;
+  return Status(ErrorCode::kInvalidArgument, "--axis '" + a + "': use x, y or z");
+}
+
+nlohmann::json box_json(const VoxelBox& b) {
+  return {{"lo", {b.lo.x, b.lo.y, b.lo.z}}, {"dims", {b.dims.x, b.dims.y, b.dims.z}}};
+}
+
+Result<nlohmann::json> run_dense(const VoxelizeArgs& a, const World& world, int axis, Format format, Context* ctx) {
+  VoxelizeOptions opt;
+  opt.faces = !a.occupancy_only;
+  VoxelStats stats;
+  Result<VoxelGrid> g = voxelize(world, VoxelConfig{.voxel_size = a.voxel_size, .axis = axis}, opt, ctx, &stats);
+  if (!g.ok()) return g.status();
+  Status s = format == Format::kVdb ? save_vdb(g.value(), a.output, a.world) : save_raw(g.value(), a.output);
+  if (!s.ok()) return s;
+  return nlohmann::json{{"mode", "dense"},
+                        {"voxel_size", a.voxel_size},
+                        {"box", box_json(g.value().box)},
+                        {"voxels", stats.voxels},
+                        {"surface_voxels", stats.surface_voxels},
+                        {"volume_m3", g.value().volume()},
+                        {"world_volume_m3", world.volume(axis)},
+                        {"chunk_columns_closed", stats.chunk_columns_closed},
+                        {"chunk_columns_walked", stats.chunk_columns_walked},
+                        {"rays_walked", stats.rays_walked},
+                        {"voxelize_seconds", stats.seconds}};
+}
+
+Result<nlohmann::json> run_cascades(const VoxelizeArgs& a, const World& world, int axis, Format format, Context* ctx) {
+  glm::dvec3 camera(0.0);
+  if (!a.camera.empty()) {
+    if (!parse_vec3(a.camera, &camera)) {
+      return Status(ErrorCode::kInvalidArgument, "--camera '" + a.camera + "': expected three finite numbers x,y,z");
+    }
+  } else if (auto b = world.solid_bounds()) {
+    camera = 0.5 * (b->min + b->max);
+  }
+  CascadeConfig cfg;
+  cfg.levels = a.cascades;
+  cfg.resolution = a.resolution;
+  cfg.voxel_size = a.voxel_size;
+  cfg.axis = axis;
+  Result<Cascades> c = Cascades::create(world.lattice(), cfg);
+  if (!c.ok()) return c.status();
+  const auto start = std::chrono::steady_clock::now();
+  Status s = c.value().update_all(world, camera, ctx);
+  if (!s.ok()) return s;
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  s = format == Format::kVdb ? save_vdb(c.value(), a.output, a.world) : save_raw(c.value(), a.output);
+  if (!s.ok()) return s;
+  nlohmann::json levels = nlohmann::json::array();
+  for (int k = 0; k < c.value().levels(); ++k) {
+    levels.push_back({{"voxel_size", c.value().voxel_size(k)}, {"box", box_json(c.value().level_box(k))}});
+  }
+  return nlohmann::json{{"mode", "cascades"},
+                        {"camera", {camera.x, camera.y, camera.z}},
+                        {"resolution", a.resolution},
+                        {"levels", levels},
+                        {"texture_bytes", c.value().texture().bytes()},
+                        {"voxelize_seconds", seconds}};
+}
+
+void print_text(const nlohmann::json& j) {
+  if (j["mode"] == "dense") {
+    const auto& b = j["box"]["dims"];
+    std::printf("voxelize: %d x %d x %d voxels of %g m, %zu surface voxels, volume %.6g m^3 (spans: %.6g), %.3f s\n",
+                b[0].get<int>(), b[1].get<int>(), b[2].get<int>(), j["voxel_size"].get<double>(),
+                j["surface_voxels"].get<size_t>(), j["volume_m3"].get<double>(), j["world_volume_m3"].get<double>(),
+                j["voxelize_seconds"].get<double>());
+    std::printf("chunk columns: %zu closed form or empty, %zu walked (%zu rays)\n",
+                j["chunk_columns_closed"].get<size_t>(), j["chunk_columns_walked"].get<size_t>(),
+                j["rays_walked"].get<size_t>());
+  } else {
+    std::printf("voxelize: %zu cascade levels of %d^3 voxels around (%s), %.3f s\n", j["levels"].size(),
+                j["resolution"].get<int>(), detail::vec_text({j["camera"][0].get<double>(), j["camera"][1].get<double>(),
+                                                               j["camera"][2].get<double>()}).c_str(),
+                j["voxelize_seconds"].get<double>());
+    for (size_t k = 0; k < j["levels"].size(); ++k) {
+      std::printf("  level %zu: voxel %g m\n", k, j["levels"][k]["voxel_size"].get<double>());
+    }
+  }
+  std::printf("wrote %s\n", j["output"].get<std::string>().c_str());
+}
+
+int run_voxelize(const VoxelizeArgs& a, const CommonOptions& common) {
+  set_thread_count(common.threads);
+  Result<Format> format = output_format(a.output);
+  if (!format.ok()) return fail("voxelize", format.status());
+  Result<int> axis = parse_axis(a.axis);
+  if (!axis.ok()) return fail("voxelize", axis.status());
+  if (a.cascades < 0) return fail("voxelize", "--cascades " + std::to_string(a.cascades) + ": must be >= 1");
+  if (a.cascades == 0 && !a.camera.empty()) return fail("voxelize", "--camera needs --cascades K");
+  Result<World> world = load_world(a.world);
+  if (!world.ok()) return fail("voxelize", world.status());
+  ProgressBar bar(!common.quiet);
+  Result<nlohmann::json> j = a.cascades > 0 ? run_cascades(a, world.value(), axis.value(), format.value(), bar.context())
+                                            : run_dense(a, world.value(), axis.value(), format.value(), bar.context());
+  bar.finish();
+  if (!j.ok()) return fail("voxelize", j.status());
+  j.value()["ok"] = true;
+  j.value()["input"] = a.world;
+  j.value()["output"] = a.output;
+  j.value()["threads"] = thread_count();
+  if (common.json) {
+    std::printf("%s\n", j.value().dump(2).c_str());
+  } else {
+    print_text(j.value());
+  }
+  return 0;
+}
+
+}  // namespace
+
+void add_voxelize_command(CLI::App& app, CommonOptions& common) {
+  auto args = std::make_shared<VoxelizeArgs>();
+  CLI::App* cmd = app.add_subcommand("voxelize", "Solid occupancy and the six-face G-buffer -> .vdb or raw + JSON");
+  cmd->footer(kVoxelizeHelp);
+  cmd->add_option("world", args->world, "Input .ldc file")->required();
+  cmd->add_option("-o,--output", args->output, "Output .vdb, .json or .raw")->required();
+  cmd->add_option("--voxel-size", args->voxel_size, "Voxel edge (m): a whole number of cells h")->required();
+  cmd->add_option("--cascades", args->cascades, "Camera-centred cascade levels K (0 = one dense grid)");
+  cmd->add_option("--resolution", args->resolution, "Voxels per axis of each cascade level")->capture_default_str();
+  cmd->add_option("--camera", args->camera, "Cascade centre x,y,z (m); default: the centre of the solid");
+  cmd->add_option("--axis", args->axis, "Ray family integrated for the occupancy: x, y or z")->capture_default_str();
+  cmd->add_flag("--occupancy-only", args->occupancy_only, "Dense grid: occupancy only, no normal/albedo (faster)");
+  cmd->callback([args, &common] {
+    int code = run_voxelize(*args, common);
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ldc::tool
