@@ -16,7 +16,7 @@ void SearchNodes::reset(uint32_t count) {
     cost.assign(count, 0.0f);
     parent.assign(count, UINT32_MAX);
     via.assign(count, 0);
-    position.assign(count, glm::dvec3(0.0));
+    position.assign(count, glm::vec3(0.0f));
     closed.assign(count, 0);
     generation = 0;
   }
@@ -85,9 +85,18 @@ glm::dvec3 nearest_point_of_region(const NavData& data, uint32_t dense, const gl
 
 namespace {
 
-glm::dvec3 portal_mid(const NavPortal& p) {
-  return {0.5 * (double(p.a.x) + p.b.x), 0.5 * (double(p.a.y) + p.b.y),
-          0.5 * (double(p.height_a) + p.height_b)};
+// Where the straight line from `from` to `goal` crosses the portal (in the
+// ground plane), clamped to the portal: the entry point that keeps g + h
+// closest to the taut path, so A* strays less than with portal midpoints.
+glm::vec3 crossing_point(const NavPortal& p, const glm::vec3& from, const glm::vec3& goal) {
+  const glm::vec2 d = glm::vec2(goal) - glm::vec2(from), e = p.b - p.a;
+  const float denom = d.x * e.y - d.y * e.x;
+  float t = 0.5f;
+  if (std::fabs(denom) > 1e-12f) {
+    const glm::vec2 w = p.a - glm::vec2(from);
+    t = std::clamp((d.y * w.x - d.x * w.y) / denom, 0.0f, 1.0f);
+  }
+  return {p.a + t * e, p.height_a + t * (p.height_b - p.height_a)};
 }
 
 // The portal ends as seen walking through it (left is a quarter turn
@@ -108,7 +117,7 @@ void NavSearch::reset(uint32_t region_count) {
 void NavSearch::push_start(uint32_t region, const glm::dvec3& at, double to_target) {
   nodes.touch(region);
   nodes.cost[region] = 0.0f;
-  nodes.position[region] = at;
+  nodes.position[region] = glm::vec3(at);
   nodes.push(region, float(to_target));
   best = region;
   best_distance = to_target;
@@ -128,17 +137,18 @@ bool NavSearch::expand_one(const NavData& data, int max_nodes) {
   uint32_t slot = 0;
   const NavRegion& r = dense_to_region(data, n, &slot);
   const NavTile& tile = data.tiles[slot];
-  const glm::dvec3 from = nodes.position[n];
+  const glm::vec3 from = nodes.position[n];
+  const glm::vec3 goal(target);
   for (uint32_t k = 0; k < r.portal_count; ++k) {
     const NavPortal& p = tile.portals[r.first_portal + k];
-    const uint32_t m = data.tiles[p.to_tile].dense_first + p.to_region;
+    const uint32_t m = p.to_dense;
     if (nodes.seen(m) && nodes.closed[m]) continue;
-    const glm::dvec3 mid = portal_mid(p);
-    double g = nodes.cost[n] + glm::length(mid - from);
-    double h = glm::length(target - mid);
+    const glm::vec3 at = crossing_point(p, from, goal);
+    float g = nodes.cost[n] + glm::length(at - from);
+    float h = glm::length(goal - at);
     if (m == target_region) {
       g += h;
-      h = 0.0;
+      h = 0.0f;
     }
     if (!nodes.seen(m)) {
       if (nodes.used >= max_nodes) {
@@ -149,11 +159,11 @@ bool NavSearch::expand_one(const NavData& data, int max_nodes) {
     } else if (g >= nodes.cost[m]) {
       continue;
     }
-    nodes.cost[m] = float(g);
+    nodes.cost[m] = g;
     nodes.parent[m] = n;
     nodes.via[m] = r.first_portal + k;
-    nodes.position[m] = mid;
-    nodes.push(m, float(g + 0.999 * h));
+    nodes.position[m] = at;
+    nodes.push(m, g + 0.999f * h);
     if (h < best_distance) {
       best = m;
       best_distance = h;
@@ -299,10 +309,10 @@ NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& 
   };
   visit(sn, s);
   nodes.cost[sn] = 0.0f;
-  nodes.position[sn] = glm::dvec3(glm::round(glm::dvec2(start.point)), floor_of(data, s).height);
-  nodes.push(sn, float(glm::length(target - nodes.position[sn])));
+  nodes.position[sn] = glm::vec3(glm::dvec3(glm::round(glm::dvec2(start.point)), floor_of(data, s).height));
+  nodes.push(sn, float(glm::length(target - glm::dvec3(nodes.position[sn]))));
   uint32_t best = sn;
-  double best_h = glm::length(target - nodes.position[sn]);
+  double best_h = glm::length(target - glm::dvec3(nodes.position[sn]));
   bool reached = false, out_of_nodes = false;
   uint32_t n = 0;
   while (nodes.pop(&n)) {
@@ -312,7 +322,7 @@ NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& 
       break;
     }
     const GridFloor g = floor_of_node[nodes.via[n]];
-    const glm::dvec3 at = nodes.position[n];
+    const glm::dvec3 at(nodes.position[n]);
     const glm::ivec2 col(int(at.x), int(at.y));
     auto relax = [&](const GridFloor& next, const glm::ivec2& next_col) {
       const uint32_t m = dense_floor(data, next);
@@ -330,7 +340,7 @@ NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& 
       }
       nodes.cost[m] = float(cost);
       nodes.parent[m] = n;
-      nodes.position[m] = p;
+      nodes.position[m] = glm::vec3(p);
       const double h = glm::length(target - p);
       nodes.push(m, float(cost + h));
       if (h < best_h) {
@@ -359,7 +369,7 @@ NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& 
   path.status = reached ? PathStatus::kComplete
                         : (out_of_nodes ? PathStatus::kOutOfNodes : PathStatus::kUnreachable);
   for (uint32_t k = reached ? tn : best; k != UINT32_MAX; k = nodes.parent[k]) {
-    path.corners.push_back(nodes.position[k]);
+    path.corners.push_back(glm::dvec3(nodes.position[k]));
   }
   std::reverse(path.corners.begin(), path.corners.end());
   for (size_t i = 1; i < path.corners.size(); ++i) {

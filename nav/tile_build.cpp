@@ -466,6 +466,7 @@ void connect_tile(const NavData& data, NavTile& tile) {
         p.b = b;
         p.height_a = run.height_first;
         p.height_b = run.height_last;
+        p.mid = glm::vec3(0.5f * (a + b), 0.5f * (p.height_a + p.height_b));
         tile.portals.push_back(p);
         run.open = false;
       };
@@ -526,6 +527,9 @@ void relabel(NavData& data) {
     data.dense_tile.insert(data.dense_tile.end(), t.regions.size(), s);
   }
   data.dense_count = count;
+  for (NavTile& t : data.tiles) {
+    for (NavPortal& p : t.portals) p.to_dense = data.tiles[p.to_tile].dense_first + p.to_region;
+  }
   data.dense_floor_count = floors;
   std::vector<uint32_t> parent(count);
   std::iota(parent.begin(), parent.end(), 0u);

@@ -3,6 +3,7 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include "csg/csg.h"
 #include "ldc/build.h"
@@ -356,6 +357,31 @@ TEST(Nav, UpdateEqualsRebuildAfterRandomEdits) {
       EXPECT_EQ(pa->status, pb->status);
       EXPECT_NEAR(pa->length, pb->length, 1e-9);
     }
+  }
+}
+
+// The same world gives the same navigation whatever the thread count.
+TEST(Nav, BuildIsDeterministicAcrossThreadCounts) {
+  std::vector<Box> boxes{floor_slab(0, 0, 30, 30)};
+  for (int k = 0; k < 5; ++k) boxes.push_back({{3.0 + 5 * k, 2.0 + k, 0.5}, {4.0 + 5 * k, 20.0 + k, 2.5}});
+  const World world = boxes_world(boxes);
+  auto build_with = [&](int threads) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    return nav_of(world);
+  };
+  const NavMesh one = build_with(1), two = build_with(2);
+  EXPECT_EQ(one.stats().regions, two.stats().regions);
+  EXPECT_EQ(one.stats().portals, two.stats().portals);
+  NavQuery qa(one), qb(two);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> x(0.5, 29.5);
+  for (int k = 0; k < 30; ++k) {
+    const glm::dvec3 p(x(rng), x(rng), 1.0), q(x(rng), x(rng), 1.0);
+    Result<NavPath> a = qa.find_path(p, q), b = qb.find_path(p, q);
+    ASSERT_EQ(a.ok(), b.ok());
+    if (!a.ok()) continue;
+    ASSERT_EQ(a->corners.size(), b->corners.size());
+    for (size_t i = 0; i < a->corners.size(); ++i) EXPECT_EQ(a->corners[i], b->corners[i]);
   }
 }
 

@@ -55,12 +55,14 @@ struct NavRegion {
 // segment from a to b (2D lattice coordinates), heights at both ends.
 struct NavPortal {
   uint32_t to_tile = 0;
+  uint32_t to_dense = 0;  // the target's dense index (set by relabel)
   uint16_t to_region = 0;
   uint8_t dir = 0;  // side of the source region it lies on
   glm::vec2 a{0.0f};
   glm::vec2 b{0.0f};
   float height_a = 0.0f;
   float height_b = 0.0f;
+  glm::vec3 mid{0.0f};  // the middle of the segment, where A* enters the target
 };
 
 struct NavTile {

@@ -34,7 +34,7 @@ struct SearchNodes {
   std::vector<float> cost;           // g
   std::vector<uint32_t> parent;      // node index, or UINT32_MAX
   std::vector<uint32_t> via;         // region search: portal index in the parent's tile
-  std::vector<glm::dvec3> position;  // where the node is entered
+  std::vector<glm::vec3> position;   // where the node is entered
   std::vector<uint8_t> closed;
   std::vector<std::pair<float, uint32_t>> heap;  // (f, node), min-heap by f
   uint32_t generation = 0;
