@@ -466,7 +466,6 @@ void connect_tile(const NavData& data, NavTile& tile) {
         p.b = b;
         p.height_a = run.height_first;
         p.height_b = run.height_last;
-        p.mid = glm::vec3(0.5f * (a + b), 0.5f * (p.height_a + p.height_b));
         tile.portals.push_back(p);
         run.open = false;
       };

@@ -62,7 +62,6 @@ struct NavPortal {
   glm::vec2 b{0.0f};
   float height_a = 0.0f;
   float height_b = 0.0f;
-  glm::vec3 mid{0.0f};  // the middle of the segment, where A* enters the target
 };
 
 struct NavTile {
