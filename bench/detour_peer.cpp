@@ -410,3 +410,21 @@ double detour_rebuild_tile(DetourNav& nav_, const std::vector<float>& verts, con
 }
 
 }  // namespace ldc::bench
+
+namespace ldc::bench {
+
+// The nearest point of Detour's navmesh within half_extents of p, for
+// comparing walkable areas (bench_nav's diagnostics).
+bool detour_nearest_point(DetourNav& nav, const glm::vec3& p, const glm::vec3& half_extents,
+                          glm::vec3* nearest) {
+  DetourNav::Impl& impl = nav.impl();
+  dtPolyRef ref = 0;
+  float out[3];
+  if (dtStatusFailed(impl.query->findNearestPoly(&p.x, &half_extents.x, &impl.filter, &ref, out)) || !ref) {
+    return false;
+  }
+  *nearest = glm::vec3(out[0], out[1], out[2]);
+  return true;
+}
+
+}  // namespace ldc::bench

@@ -72,6 +72,10 @@ struct DetourPath {
 // last poly nearest the goal (as RecastDemo's NavMeshTesterTool).
 DetourPath detour_find_path(DetourNav& nav, const glm::vec3& start, const glm::vec3& goal);
 
+// The nearest point of the navmesh within half_extents of p (Detour's frame); false when none.
+bool detour_nearest_point(DetourNav& nav, const glm::vec3& p, const glm::vec3& half_extents,
+                          glm::vec3* nearest);
+
 // Tiled navmesh only: replaces the triangles (e.g. after a dig), rebuilds the
 // one tile containing `at` (Recast build of that tile from the triangles
 // overlapping it + removeTile/addTile) and returns the milliseconds it took
