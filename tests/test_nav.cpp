@@ -330,6 +330,23 @@ TEST(Nav, DigOpensAShortcutAndFillClosesIt) {
   EXPECT_NEAR(path_of(nav, a, b).length, around, 1e-6);
 }
 
+// A build beyond the world's box grows the world: the update rebuilds all and
+// the new ground is walkable and linked.
+TEST(Nav, UpdateFollowsAWorldThatGrew) {
+  const World world = boxes_world({floor_slab(0, 0, 8, 4)});
+  NavMesh nav = nav_of(world);
+  WorldEditor editor(world);
+  // A slab continuing the floor eastwards, well past the box.
+  ASSERT_TRUE(editor.apply(Brush::box({14.0, 2.0, 0.625}, {6.1, 1.95, 0.375}), EditOp::kAdd).ok());
+  ASSERT_GT(editor.world().chunk_dims().x, world.chunk_dims().x);
+  Result<NavUpdateStats> up = nav.update(editor.world(), editor.take_dirty());
+  ASSERT_TRUE(up.ok());
+  EXPECT_TRUE(up->full_rebuild);
+  const NavPath path = path_of(nav, {2, 2, 1}, {18, 2, 1});
+  EXPECT_EQ(path.status, PathStatus::kComplete);
+  EXPECT_NEAR(path.length, 16.0, 1e-3);
+}
+
 // After random digs and builds, the updated mesh equals one built from scratch.
 TEST(Nav, UpdateEqualsRebuildAfterRandomEdits) {
   const World world = boxes_world({floor_slab(0, 0, 16, 16), {{6.9, 2.0, 0.5}, {7.1, 14.0, 3.0}}});
