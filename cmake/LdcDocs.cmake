@@ -9,8 +9,13 @@ if(DOXYGEN_FOUND)
     ${PROJECT_SOURCE_DIR}/ldc ${PROJECT_SOURCE_DIR}/contour ${PROJECT_SOURCE_DIR}/csg
     ${PROJECT_SOURCE_DIR}/nav ${PROJECT_SOURCE_DIR}/voxelize ${PROJECT_SOURCE_DIR}/capi)
   string(REPLACE ";" " " LDC_DOXYGEN_INPUT "${LDC_DOXYGEN_INPUT}")
+  set(LDC_DOXYGEN_HAVE_DOT NO)
+  if(DOXYGEN_DOT_FOUND)
+    set(LDC_DOXYGEN_HAVE_DOT YES)  # include graphs when Graphviz is there
+  endif()
   configure_file(${PROJECT_SOURCE_DIR}/docs/Doxyfile.in ${PROJECT_BINARY_DIR}/Doxyfile @ONLY)
   add_custom_target(docs
+    COMMAND ${CMAKE_COMMAND} -E make_directory ${PROJECT_BINARY_DIR}/docs
     COMMAND ${DOXYGEN_EXECUTABLE} ${PROJECT_BINARY_DIR}/Doxyfile
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
     COMMENT "Doxygen API reference -> ${PROJECT_BINARY_DIR}/docs/html/index.html"
