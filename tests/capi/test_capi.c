@@ -249,6 +249,74 @@ static void chunk_meshes_follow_the_edits(ldc_world* w) {
   CHECK(e.vertex_count == 0 && e.triangle_count == 0);
 }
 
+/* FNV-1a of one chunk's mesh (counts, positions, indices, materials). */
+static uint64_t mesh_hash(ldc_world* w, const int32_t c[3]) {
+  ldc_mesh_buffers b = {0};
+  CHECK_STATUS(ldc_world_mesh_chunk(w, c, &b), LDC_OK);
+  uint64_t h = 1469598103934665603ull ^ (uint64_t)b.vertex_count * 31u ^ (uint64_t)b.triangle_count;
+  if (b.triangle_count == 0) return h;
+  b.positions = malloc(b.vertex_count * 3 * sizeof(float));
+  b.indices = malloc(b.triangle_count * 3 * sizeof(uint32_t));
+  b.triangle_materials = malloc(b.triangle_count * sizeof(uint16_t));
+  b.vertex_capacity = b.vertex_count, b.triangle_capacity = b.triangle_count;
+  CHECK_STATUS(ldc_world_mesh_chunk(w, c, &b), LDC_OK);
+  const unsigned char* parts[3] = {(const unsigned char*)b.positions, (const unsigned char*)b.indices,
+                                   (const unsigned char*)b.triangle_materials};
+  const size_t sizes[3] = {b.vertex_count * 3 * sizeof(float), b.triangle_count * 3 * sizeof(uint32_t),
+                           b.triangle_count * sizeof(uint16_t)};
+  for (int p = 0; p < 3; ++p)
+    for (size_t i = 0; i < sizes[p]; ++i) h = (h ^ parts[p][i]) * 1099511628211ull;
+  free(b.positions), free(b.indices), free(b.triangle_materials);
+  return h;
+}
+
+/* Every chunk whose mesh an edit changes is in the dirty list with LDC_DIRTY_MESH. */
+static void changed_meshes_are_flagged_dirty(ldc_world* w) {
+  g_case = "changed_meshes_are_flagged_dirty";
+  ldc_world_info info;
+  CHECK_STATUS(ldc_world_get_info(w, &info), LDC_OK);
+  const size_t chunks = (size_t)info.chunk_dims[0] * info.chunk_dims[1] * info.chunk_dims[2];
+  uint64_t* before = calloc(chunks, sizeof *before);
+  size_t n = 0;
+  ldc_world_take_dirty(w, NULL, 0, &n);
+  ldc_dirty_chunk* skip = calloc(n + 1, sizeof *skip);
+  CHECK_STATUS(ldc_world_take_dirty(w, skip, n, &n), LDC_OK); /* start from a clean list */
+  free(skip);
+  for (size_t i = 0; i < chunks; ++i) {
+    const int32_t c[3] = {info.chunk_origin[0] + (int32_t)(i % info.chunk_dims[0]),
+                          info.chunk_origin[1] + (int32_t)(i / info.chunk_dims[0] % info.chunk_dims[1]),
+                          info.chunk_origin[2] + (int32_t)(i / info.chunk_dims[0] / info.chunk_dims[1])};
+    before[i] = mesh_hash(w, c);
+  }
+  /* A dig on a chunk corner (h = 0.25, C = 32: chunks are 8 m) touches up to eight chunks. */
+  ldc_brush b = {0};
+  b.shape = LDC_BRUSH_SPHERE;
+  b.centre[0] = 8.0, b.centre[1] = 8.0, b.centre[2] = ground_z(w, 8.5, 8.5);
+  b.radius = 1.0;
+  b.material = 1;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_BUILD, NULL), LDC_OK);
+  ldc_world_take_dirty(w, NULL, 0, &n);
+  ldc_dirty_chunk* dirty = calloc(n + 1, sizeof *dirty);
+  CHECK_STATUS(ldc_world_take_dirty(w, dirty, n, &n), LDC_OK);
+  size_t changed = 0;
+  for (size_t i = 0; i < chunks; ++i) {
+    const int32_t c[3] = {info.chunk_origin[0] + (int32_t)(i % info.chunk_dims[0]),
+                          info.chunk_origin[1] + (int32_t)(i / info.chunk_dims[0] % info.chunk_dims[1]),
+                          info.chunk_origin[2] + (int32_t)(i / info.chunk_dims[0] / info.chunk_dims[1])};
+    if (mesh_hash(w, c) == before[i]) continue;
+    ++changed;
+    int flagged = 0;
+    for (size_t k = 0; k < n; ++k) {
+      flagged |= dirty[k].chunk[0] == c[0] && dirty[k].chunk[1] == c[1] && dirty[k].chunk[2] == c[2] &&
+                 (dirty[k].flags & LDC_DIRTY_MESH);
+    }
+    CHECK(flagged);
+  }
+  CHECK(changed >= 2);
+  free(before);
+  free(dirty);
+}
+
 static void ray_casts_find_the_ground(ldc_world* w) {
   g_case = "ray_casts_find_the_ground";
   ldc_ray rays[3] = {
@@ -376,6 +444,7 @@ int main(int argc, char** argv) {
   bad_brush_leaves_the_world_unchanged(w);
   dirty_chunks_are_taken_once(w);
   chunk_meshes_follow_the_edits(w);
+  changed_meshes_are_flagged_dirty(w);
   ray_casts_find_the_ground(w);
   paths_cross_the_landscape(w);
   cascades_voxelize_a_level(w);
