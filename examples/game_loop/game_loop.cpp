@@ -259,7 +259,7 @@ bool render_frame(const Session& s, const Options& o, int frame) {
           << s.agent.x << ", " << s.agent.y << ", " << s.agent.z + 0.5 << "]]}\n";
   overlay.close();
   const std::string cmd = "\"" + o.ldc_tool + "\" -q render \"" + ldc_path + "\" -o \"" + png_path +
-                          "\" --camera 24,-14,30 --target 24,24,4 --fov 55 --width 640 --height 360 --shadows" +
+                          "\" --camera 24,6,40 --target 24,26,3 --fov 60 --width 640 --height 360 --shadows" +
                           " --overlay \"" + overlay_path + "\" > /dev/null";
   if (std::system(cmd.c_str()) != 0) {
     std::fprintf(stderr, "render failed: %s\n", cmd.c_str());
