@@ -29,7 +29,8 @@
  *    batched ray casts, voxelizing) run in parallel internally (TBB).
  *    ldc_last_error() is per thread.
  *  - No exceptions or C++ types cross this header; out of memory is
- *    reported as LDC_TOO_LARGE.
+ *    reported as LDC_TOO_LARGE. Enums are 32 bits wide (the *_MAX_ENUM
+ *    entries); a value outside an enum's list is refused by name.
  *
  * Versioning: LDC_C_API_VERSION changes when a declaration here changes
  * incompatibly; structs only grow at the end, behind a new API version. The
@@ -74,7 +75,8 @@ typedef enum ldc_status {
   LDC_CANCELLED = 7,
   LDC_INTERNAL = 8,         /* a bug in ldc: please report it with the message */
   LDC_BUFFER_TOO_SMALL = 9, /* a caller buffer is too small: the needed count was written */
-  LDC_NOT_FOUND = 10        /* e.g. no walkable floor near a path's start or goal */
+  LDC_NOT_FOUND = 10,       /* e.g. no walkable floor near a path's start or goal */
+  LDC_STATUS_MAX_ENUM = 0x7fffffff /* keeps every enum 32 bits wide (not a status) */
 } ldc_status;
 
 /* "ok", "invalid argument", ... (static strings). */
@@ -152,14 +154,16 @@ LDC_C_API int ldc_world_inside(const ldc_world* world, const double point[3]);
 typedef enum ldc_brush_shape {
   LDC_BRUSH_SPHERE = 0,  /* centre, radius */
   LDC_BRUSH_BOX = 1,     /* centre, half_extents (axis-aligned) */
-  LDC_BRUSH_CAPSULE = 2  /* a, b (segment ends), radius */
+  LDC_BRUSH_CAPSULE = 2, /* a, b (segment ends), radius */
+  LDC_BRUSH_SHAPE_MAX_ENUM = 0x7fffffff
 } ldc_brush_shape;
 
 typedef enum ldc_edit_op {
   LDC_EDIT_DIG = 0,       /* subtract the brush */
   LDC_EDIT_BUILD = 1,     /* add the brush (new surface takes its material) */
   LDC_EDIT_PAINT = 2,     /* surface inside the brush takes its material */
-  LDC_EDIT_INTERSECT = 3  /* keep only what is inside the brush */
+  LDC_EDIT_INTERSECT = 3, /* keep only what is inside the brush */
+  LDC_EDIT_OP_MAX_ENUM = 0x7fffffff
 } ldc_edit_op;
 
 typedef struct ldc_brush {
@@ -273,7 +277,8 @@ LDC_C_API ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_co
 typedef enum ldc_path_status {
   LDC_PATH_COMPLETE = 0,     /* reaches the goal */
   LDC_PATH_UNREACHABLE = 1,  /* ends at the start island's point nearest the goal */
-  LDC_PATH_OUT_OF_NODES = 2  /* the node budget ran out: ends nearest the goal explored */
+  LDC_PATH_OUT_OF_NODES = 2, /* the node budget ran out: ends nearest the goal explored */
+  LDC_PATH_STATUS_MAX_ENUM = 0x7fffffff
 } ldc_path_status;
 
 typedef struct ldc_path_info {

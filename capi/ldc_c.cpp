@@ -66,6 +66,17 @@ ldc_status null_argument(const char* call, const char* name) {
   return fail(LDC_INVALID_ARGUMENT, std::string(call) + ": " + name + " is NULL");
 }
 
+// The value of an enum a C caller passed, read as the int it is: a C caller
+// may pass any int, and loading a C++ enum outside its enumerators' range is
+// undefined (UBSan flags it).
+template <class E>
+int32_t raw_enum(const E& e) {
+  static_assert(sizeof(E) == sizeof(int32_t));
+  int32_t v;
+  std::memcpy(&v, &e, sizeof v);
+  return v;
+}
+
 glm::dvec3 vec3(const double v[3]) { return {v[0], v[1], v[2]}; }
 glm::ivec3 ivec3(const int32_t v[3]) { return {v[0], v[1], v[2]}; }
 void put(const glm::dvec3& v, double out[3]) { out[0] = v.x, out[1] = v.y, out[2] = v.z; }
@@ -159,14 +170,15 @@ void ldc_world::fan_out(const std::vector<ldc::DirtyChunk>& dirty) {
 extern "C" {
 
 const char* ldc_status_name(ldc_status status) {
-  switch (status) {
+  const int32_t s = raw_enum(status);
+  switch (s) {
     case LDC_OK: return "ok";
     case LDC_BUFFER_TOO_SMALL: return "buffer too small";
     case LDC_NOT_FOUND: return "not found";
     default: break;
   }
-  if (status > LDC_OK && status <= LDC_INTERNAL) {
-    return ldc::error_code_name(static_cast<ldc::ErrorCode>(status));
+  if (s > LDC_OK && s <= LDC_INTERNAL) {
+    return ldc::error_code_name(static_cast<ldc::ErrorCode>(s));
   }
   return "unknown status";
 }
@@ -305,16 +317,17 @@ int ldc_world_inside(const ldc_world* world, const double point[3]) {
 // Edits
 
 static ldc::Result<ldc::Brush> to_brush(const ldc_brush& b) {
-  switch (b.shape) {
+  const int32_t shape = raw_enum(b.shape);
+  switch (shape) {
     case LDC_BRUSH_SPHERE: return ldc::Brush::sphere(vec3(b.centre), b.radius, b.material);
     case LDC_BRUSH_BOX: return ldc::Brush::box(vec3(b.centre), vec3(b.half_extents), b.material);
     case LDC_BRUSH_CAPSULE: return ldc::Brush::capsule(vec3(b.a), vec3(b.b), b.radius, b.material);
   }
   return ldc::Status(ldc::ErrorCode::kInvalidArgument,
-                     "brush shape " + std::to_string(int(b.shape)) + ": use sphere (0), box (1) or capsule (2)");
+                     "brush shape " + std::to_string(shape) + ": use sphere (0), box (1) or capsule (2)");
 }
 
-static ldc::Result<ldc::EditOp> to_op(ldc_edit_op op) {
+static ldc::Result<ldc::EditOp> to_op(int32_t op) {
   switch (op) {
     case LDC_EDIT_DIG: return ldc::EditOp::kSubtract;
     case LDC_EDIT_BUILD: return ldc::EditOp::kAdd;
@@ -322,7 +335,7 @@ static ldc::Result<ldc::EditOp> to_op(ldc_edit_op op) {
     case LDC_EDIT_INTERSECT: return ldc::EditOp::kIntersect;
   }
   return ldc::Status(ldc::ErrorCode::kInvalidArgument,
-                     "edit op " + std::to_string(int(op)) + ": use dig (0), build (1), paint (2) or intersect (3)");
+                     "edit op " + std::to_string(op) + ": use dig (0), build (1), paint (2) or intersect (3)");
 }
 
 ldc_status ldc_world_edit(ldc_world* world, const ldc_brush* brush, ldc_edit_op op, ldc_edit_result* out) {
@@ -331,7 +344,7 @@ ldc_status ldc_world_edit(ldc_world* world, const ldc_brush* brush, ldc_edit_op 
     if (!brush) return null_argument("ldc_world_edit", "brush");
     ldc::Result<ldc::Brush> b = to_brush(*brush);
     if (!b.ok()) return from_status(b.status());
-    ldc::Result<ldc::EditOp> o = to_op(op);
+    ldc::Result<ldc::EditOp> o = to_op(raw_enum(op));
     if (!o.ok()) return from_status(o.status());
     ldc::Result<ldc::EditReceipt> receipt = world->editor.apply(b.value(), o.value());
     if (!receipt.ok()) return from_status(receipt.status());

@@ -53,6 +53,9 @@ static void version_matches_the_header(void) {
   CHECK(ldc_format_version() == LDC_FORMAT_VERSION);
   CHECK(strcmp(ldc_status_name(LDC_OK), "ok") == 0);
   CHECK(strcmp(ldc_status_name(LDC_BUFFER_TOO_SMALL), "buffer too small") == 0);
+  CHECK(strcmp(ldc_status_name(LDC_INVALID_ARGUMENT), "invalid argument") == 0);
+  CHECK(strcmp(ldc_status_name((ldc_status)12345), "unknown status") == 0);
+  CHECK(sizeof(ldc_status) == 4 && sizeof(ldc_brush_shape) == 4 && sizeof(ldc_edit_op) == 4);
 }
 
 static void null_handles_are_refused_by_name(void) {
