@@ -2,7 +2,7 @@
 // frame" proof for engine programmers.
 //
 // Every frame, as a game would:
-//   1. edit     the player digs a trench (1.2 m spheres) as it walks east
+//   1. edit     the player digs a trench (1.2 m spheres) as it walks west
 //               across the landscape (every fifth frame it builds a pillar
 //               beside the trench instead): one WorldEditor::apply;
 //   2. re-mesh  the chunks the edit dirtied are re-meshed (ChunkedMesh::update);
@@ -116,10 +116,13 @@ std::optional<glm::dvec3> ground(const ldc::Queries& q, double x, double y) {
   return hit->point;
 }
 
-// The player walks east along y = 24 from x = 8 to 40 over the session.
+// The player walks west along y = 24 from the east edge (x = 47.5) to x = 12
+// over the session: its trench soon cuts the agent's route around the east
+// side, and the agent has to re-plan (a detour, then no way across: its path
+// then ends at the nearest point it can reach, status "unreachable").
 glm::dvec2 player_xy(int frame, int frames) {
   const double t = frames > 1 ? double(frame) / double(frames - 1) : 0.0;
-  return {8.0 + 32.0 * t, 24.0};
+  return {47.5 - 35.5 * t, 24.0};
 }
 
 double apply_edit(Session& s, int frame) {
