@@ -25,6 +25,12 @@
 // Chunked meshing: each chunk meshes the cells it owns and the quads of the
 // edges it owns, reading its neighbours' rays for the cells and edges across
 // its border. The assembled mesh equals meshing the world in one piece.
+//
+// Thread safety: contour_world, contour_chunk, marching_cubes and
+// mesh_quality only read their inputs (const; no edit may run meanwhile) and
+// may run concurrently. A ChunkedMesh is not thread-safe (one owner, e.g. the
+// render thread); each build/update is parallel inside (TBB) and gives the
+// same mesh for any thread count. Meshes are returned by value.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,7 @@
 // Writing (and reading back) contoured meshes: OBJ, PLY, STL, binary glTF, Draco.
+// Re-entrant: calls on different paths may run concurrently. Positions are
+// written in the mesh's units (metres): as text (OBJ), doubles (PLY), 32-bit
+// floats (STL, GLB) or quantized (Draco, see ExportOptions below).
 #pragma once
 
 #include <string>

@@ -23,6 +23,11 @@
 // onto the rays of the chunks it overlaps; no other chunk is read or written.
 // Every edit marks the chunks it changed dirty with a version number and
 // returns an undo handle.
+//
+// Thread safety: boolean(), mesh_boolean() and rasterize_brush() only read
+// their inputs and may run concurrently; results share unchanged chunks with
+// the inputs (cheap, immutable). A WorldEditor is not thread-safe (see the
+// class); its world() may be read by queries between edits.
 #pragma once
 
 #include <array>

@@ -2,6 +2,12 @@
 // and the procedural landscape, each into a World. All run in parallel over
 // chunk columns and axes with TBB, and none leave a half-built World behind:
 // on error (or cancel) they return a Status and no World.
+//
+// Thread safety and ownership: builders only read their inputs (meshes,
+// solids, heightfields: const, not kept after the call) and return a new
+// World by value; any number may run at once. ImplicitSolid::value(),
+// normal() and classify() are called from several worker threads at once and
+// must be safe for that (const and free of shared mutable state).
 #pragma once
 
 #include <cstdint>

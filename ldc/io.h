@@ -16,6 +16,12 @@
 // every chunk is validated (sorted, alternating, in range, axes agree), and
 // the first problem found is returned as kCorruptData naming the section,
 // chunk and field.
+//
+// Thread safety: save/serialize only read the World (const; no edit may run
+// meanwhile) and may run beside queries; loads are independent of each
+// other. Files are written to a temporary path and renamed into place.
+// Versions: kLdcFormatVersion is LDC_FORMAT_VERSION of ldc/version.h; a file
+// of another version is refused with kUnsupported naming both numbers.
 #pragma once
 
 #include <cstdint>

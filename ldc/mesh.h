@@ -4,6 +4,10 @@
 // refuse malformed input with a message naming the file, the line (text
 // formats) or byte offset (binary formats) and the offending value. They never
 // crash and never allocate more than the file's own size justifies.
+//
+// Units: positions are in the caller's units (metres for the builders and
+// brushes, which take them as world coordinates). Thread safety: the loaders
+// and free functions are re-entrant; a TriangleMesh is a plain value.
 #pragma once
 
 #include <cstdint>

@@ -3,6 +3,8 @@
 // No exceptions cross the public API. A call that can fail returns a Status
 // (or a Result<T> holding either a value or a Status). The message names what
 // was wrong in terms a user can act on: the file, the line, the value.
+// Status and Result are plain values (copyable, movable, thread-compatible).
+// The C API (capi/ldc.h) maps ErrorCode n to ldc_status n.
 #pragma once
 
 #include <optional>

@@ -4,6 +4,9 @@
 // overhangs (the terrain is warped sideways with height, so cliffs lean out)
 // and rock arches standing on the ground. Deterministic for a given seed on
 // every machine and thread count.
+//
+// Thread safety: build_terrain is re-entrant; the solid returned by
+// make_terrain_solid is immutable and safe to evaluate from many threads.
 #pragma once
 
 #include <cstdint>

@@ -10,6 +10,10 @@
 # and `ldc render` draws the dug landscape from the south-east as
 # out/tunnel.png (one ray cast per pixel, with shadows) with that path on top:
 # dashed where the ground hides it (docs/images/default-landscape.png is a copy).
+# Last, examples/game_loop plays 60 frames on the landscape (each frame: a dig
+# or a build, re-mesh, nav update, an agent re-planning, ground ray casts) and
+# prints the per-frame timings as a table with median, p95 and max; four of
+# its frames are rendered to out/game_loop/frame_*.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -22,3 +26,4 @@ mkdir -p out
 ./build/tools/ldc path out/tunnel.ldc --from 47,10,2 --to 24,7.5,2 -o out/path.json
 ./build/tools/ldc render out/tunnel.ldc -o out/tunnel.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
   --width 960 --height 540 --shadows --overlay out/path.json
+./build/examples/game_loop/game_loop --frames 60 --png out/game_loop

@@ -3,12 +3,15 @@
 
 #include "common.h"
 #include "ldc/io.h"
+#include "ldc/version.h"
 
 int main(int argc, char** argv) {
   CLI::App app{"ldc: Layered Depth Cube geometry kernel (format version " +
                std::to_string(ldc::kLdcFormatVersion) + ")"};
   app.require_subcommand(1);
   app.fallthrough();  // global flags may follow the subcommand
+  app.set_version_flag("--version", std::string("ldc ") + LDC_VERSION_STRING + " (.ldc format version " +
+                                        std::to_string(ldc::kLdcFormatVersion) + ")");
   ldc::tool::CommonOptions common;
   app.add_flag("--json", common.json, "Machine-readable JSON on stdout");
   app.add_flag("-q,--quiet", common.quiet, "No progress bar");

@@ -1,0 +1,680 @@
+// The C API (capi/ldc.h) over the C++ modules. Each entry point checks its
+// arguments, calls the C++ API inside a guard that turns exceptions
+// (std::bad_alloc, anything else) into a status, and records the message of
+// a failure in a thread-local string.
+//
+// A world handle owns a WorldEditor and what the C API keeps beside it: the
+// query cache, the chunk meshes, the navigation mesh and the cascades made
+// from it. After every edit the editor's dirty chunks are fanned out to each
+// of them (pending lists applied lazily before their next use) and to the
+// list ldc_world_take_dirty hands to the caller.
+#include "capi/ldc.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <exception>
+#include <map>
+#include <memory>
+#include <new>
+#include <optional>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "contour/contour.h"
+#include "csg/csg.h"
+#include "ldc/io.h"
+#include "ldc/query.h"
+#include "ldc/terrain.h"
+#include "ldc/version.h"
+#include "ldc/world.h"
+#include "nav/nav.h"
+#include "voxelize/voxelize.h"
+
+static_assert(LDC_FORMAT_VERSION == ldc::kLdcFormatVersion, "ldc/version.h and ldc/io.h disagree");
+
+namespace {
+
+thread_local std::string g_last_error;
+
+ldc_status fail(ldc_status status, std::string message) {
+  g_last_error = std::move(message);
+  return status;
+}
+
+ldc_status from_status(const ldc::Status& status) {
+  if (status.ok()) return LDC_OK;
+  return fail(static_cast<ldc_status>(status.code()), status.message());
+}
+
+// Runs fn (returning ldc_status) with exceptions turned into statuses.
+template <class Fn>
+ldc_status guarded(const char* call, Fn&& fn) {
+  try {
+    return fn();
+  } catch (const std::bad_alloc&) {
+    return fail(LDC_TOO_LARGE, std::string(call) + ": out of memory");
+  } catch (const std::exception& e) {
+    return fail(LDC_INTERNAL, std::string(call) + ": " + e.what());
+  } catch (...) {
+    return fail(LDC_INTERNAL, std::string(call) + ": unknown exception");
+  }
+}
+
+ldc_status null_argument(const char* call, const char* name) {
+  return fail(LDC_INVALID_ARGUMENT, std::string(call) + ": " + name + " is NULL");
+}
+
+// The value of an enum a C caller passed, read as the int it is: a C caller
+// may pass any int, and loading a C++ enum outside its enumerators' range is
+// undefined (UBSan flags it).
+template <class E>
+int32_t raw_enum(const E& e) {
+  static_assert(sizeof(E) == sizeof(int32_t));
+  int32_t v;
+  std::memcpy(&v, &e, sizeof v);
+  return v;
+}
+
+glm::dvec3 vec3(const double v[3]) { return {v[0], v[1], v[2]}; }
+glm::ivec3 ivec3(const int32_t v[3]) { return {v[0], v[1], v[2]}; }
+void put(const glm::dvec3& v, double out[3]) { out[0] = v.x, out[1] = v.y, out[2] = v.z; }
+void put(const glm::ivec3& v, int32_t out[3]) { out[0] = v.x, out[1] = v.y, out[2] = v.z; }
+void put(const glm::vec3& v, float out[3]) { out[0] = v.x, out[1] = v.y, out[2] = v.z; }
+
+// Sorts chunks by (z, y, x), the order take_dirty promises.
+using ChunkKey = std::tuple<int, int, int>;
+ChunkKey key_of(const glm::ivec3& c) { return {c.z, c.y, c.x}; }
+
+}  // namespace
+
+struct ldc_cascades {
+  ldc_world* world = nullptr;  // nulled when the world is destroyed first
+  ldc::Cascades cascades;
+  std::vector<ldc::DirtyChunk> pending;
+  ldc::PackedGBuffer scratch;
+};
+
+struct ldc_world {
+  explicit ldc_world(ldc::World w) : editor(std::move(w)) {}
+
+  ldc::WorldEditor editor;
+  std::unique_ptr<ldc::Queries> queries;  // on first ray cast
+  bool queries_stale = false;             // edits since the last refresh()
+
+  std::map<ChunkKey, ldc_dirty_chunk> user_dirty;
+
+  ldc::ContourConfig contour_config;
+  ldc::ChunkedMesh mesh{contour_config};
+  bool mesh_built = false;
+  std::vector<ldc::DirtyChunk> mesh_pending;
+
+  ldc::NavConfig nav_config;
+  int max_nodes = 2048;
+  glm::dvec3 search_half_extents{2.0, 2.0, 4.0};
+  std::optional<ldc::NavMesh> nav;
+  std::vector<ldc::DirtyChunk> nav_pending;
+
+  std::vector<ldc_cascades*> cascades;
+
+  const ldc::World& world() const { return editor.world(); }
+  void fan_out(const std::vector<ldc::DirtyChunk>& dirty);
+  void mark_mesh_neighbours(const ldc::DirtyChunk& d);
+};
+
+// Chunks whose mesh can change with d: those holding a cell within the
+// re-mesh margin (ChunkedMesh::update grows each box by relax_iterations + 1
+// cells) plus one cell for the neighbour vertices a chunk mesh copies.
+void ldc_world::mark_mesh_neighbours(const ldc::DirtyChunk& d) {
+  const int margin = contour_config.relax_iterations + 3;
+  const ldc::World& w = world();
+  const glm::ivec3 lo = w.chunk_of_node(d.node_lo - glm::ivec3(margin));
+  const glm::ivec3 hi = w.chunk_of_node(d.node_hi - glm::ivec3(1) + glm::ivec3(margin));
+  for (int z = lo.z; z <= hi.z; ++z)
+    for (int y = lo.y; y <= hi.y; ++y)
+      for (int x = lo.x; x <= hi.x; ++x) {
+        const glm::ivec3 c{x, y, z};
+        if (!w.contains_chunk(c)) continue;
+        auto [it, added] = user_dirty.try_emplace(key_of(c), ldc_dirty_chunk{});
+        if (added) put(c, it->second.chunk);
+        it->second.flags |= LDC_DIRTY_MESH;
+      }
+}
+
+void ldc_world::fan_out(const std::vector<ldc::DirtyChunk>& dirty) {
+  for (const ldc::DirtyChunk& d : dirty) {
+    auto [it, added] = user_dirty.try_emplace(key_of(d.chunk), ldc_dirty_chunk{});
+    ldc_dirty_chunk& u = it->second;
+    if (added) put(d.chunk, u.chunk);
+    if (u.flags & LDC_DIRTY_DATA) {
+      put(glm::min(ivec3(u.node_lo), d.node_lo), u.node_lo);
+      put(glm::max(ivec3(u.node_hi), d.node_hi), u.node_hi);
+    } else {
+      put(d.node_lo, u.node_lo);
+      put(d.node_hi, u.node_hi);
+    }
+    u.flags |= LDC_DIRTY_DATA;
+    u.version = d.version;
+    mark_mesh_neighbours(d);
+  }
+  mesh_pending.insert(mesh_pending.end(), dirty.begin(), dirty.end());
+  nav_pending.insert(nav_pending.end(), dirty.begin(), dirty.end());
+  for (ldc_cascades* c : cascades) c->pending.insert(c->pending.end(), dirty.begin(), dirty.end());
+  queries_stale = true;
+}
+
+// ---------------------------------------------------------------------------
+// Status and version
+
+extern "C" {
+
+const char* ldc_status_name(ldc_status status) {
+  const int32_t s = raw_enum(status);
+  switch (s) {
+    case LDC_OK: return "ok";
+    case LDC_BUFFER_TOO_SMALL: return "buffer too small";
+    case LDC_NOT_FOUND: return "not found";
+    default: break;
+  }
+  if (s > LDC_OK && s <= LDC_INTERNAL) {
+    return ldc::error_code_name(static_cast<ldc::ErrorCode>(s));
+  }
+  return "unknown status";
+}
+
+const char* ldc_last_error(void) { return g_last_error.c_str(); }
+const char* ldc_version_string(void) { return LDC_VERSION_STRING; }
+int ldc_version(void) { return LDC_VERSION; }
+int ldc_format_version(void) { return LDC_FORMAT_VERSION; }
+
+// ---------------------------------------------------------------------------
+// Worlds
+
+void ldc_world_config_default(ldc_world_config* config) {
+  if (!config) return;
+  const ldc::WorldConfig d;
+  *config = ldc_world_config{};
+  put(d.lattice.origin, config->origin);
+  config->cell_size = d.lattice.cell_size;
+  config->chunk_size = d.chunk_size;
+  put(d.chunk_origin, config->chunk_origin);
+  put(d.chunk_dims, config->chunk_dims);
+}
+
+void ldc_terrain_config_default(ldc_terrain_config* config) {
+  if (!config) return;
+  const ldc::TerrainConfig d;
+  *config = ldc_terrain_config{};
+  config->seed = d.seed;
+  config->size_x = d.size_x;
+  config->size_y = d.size_y;
+  config->base_height = d.base_height;
+  config->relief = d.relief;
+  config->cave_radius = d.cave_radius;
+  config->arches = d.arches;
+  config->cell_size = 0.2;
+}
+
+static ldc_status adopt(ldc::Result<ldc::World> world, ldc_world** out) {
+  if (!world.ok()) return from_status(world.status());
+  *out = new ldc_world(std::move(world).value());
+  return LDC_OK;
+}
+
+ldc_status ldc_world_create(const ldc_world_config* config, ldc_world** out) {
+  return guarded("ldc_world_create", [&] {
+    if (!config) return null_argument("ldc_world_create", "config");
+    if (!out) return null_argument("ldc_world_create", "out");
+    ldc::WorldConfig c;
+    c.lattice.origin = vec3(config->origin);
+    c.lattice.cell_size = config->cell_size;
+    c.chunk_size = config->chunk_size;
+    c.chunk_origin = ivec3(config->chunk_origin);
+    c.chunk_dims = ivec3(config->chunk_dims);
+    return adopt(ldc::World::create(c), out);
+  });
+}
+
+ldc_status ldc_world_create_terrain(const ldc_terrain_config* config, ldc_world** out) {
+  return guarded("ldc_world_create_terrain", [&] {
+    if (!out) return null_argument("ldc_world_create_terrain", "out");
+    ldc_terrain_config d;
+    ldc_terrain_config_default(&d);
+    const ldc_terrain_config& in = config ? *config : d;
+    ldc::TerrainConfig c;
+    c.seed = in.seed;
+    c.size_x = in.size_x;
+    c.size_y = in.size_y;
+    c.base_height = in.base_height;
+    c.relief = in.relief;
+    c.cave_radius = in.cave_radius;
+    c.arches = in.arches;
+    if (!(in.cell_size > 0.0) || !std::isfinite(in.cell_size)) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_create_terrain: cell_size " +
+                                            std::to_string(in.cell_size) + " must be a finite number > 0");
+    }
+    return adopt(ldc::build_terrain(c, in.cell_size), out);
+  });
+}
+
+ldc_status ldc_world_load(const char* path, ldc_world** out) {
+  return guarded("ldc_world_load", [&] {
+    if (!path) return null_argument("ldc_world_load", "path");
+    if (!out) return null_argument("ldc_world_load", "out");
+    return adopt(ldc::load_world(path), out);
+  });
+}
+
+ldc_status ldc_world_save(const ldc_world* world, const char* path) {
+  return guarded("ldc_world_save", [&] {
+    if (!world) return null_argument("ldc_world_save", "world");
+    if (!path) return null_argument("ldc_world_save", "path");
+    return from_status(ldc::save_world(world->world(), path));
+  });
+}
+
+void ldc_world_destroy(ldc_world* world) {
+  if (!world) return;
+  for (ldc_cascades* c : world->cascades) c->world = nullptr;
+  delete world;
+}
+
+ldc_status ldc_world_get_info(const ldc_world* world, ldc_world_info* out) {
+  return guarded("ldc_world_get_info", [&] {
+    if (!world) return null_argument("ldc_world_get_info", "world");
+    if (!out) return null_argument("ldc_world_get_info", "out");
+    const ldc::World& w = world->world();
+    const ldc::WorldStats s = w.stats();
+    const ldc::WorldBox box = w.box();
+    ldc_world_info info{};
+    put(w.lattice().origin, info.origin);
+    info.cell_size = w.lattice().cell_size;
+    info.chunk_size = w.chunk_size();
+    put(w.chunk_origin(), info.chunk_origin);
+    put(w.chunk_dims(), info.chunk_dims);
+    put(box.min, info.box_min);
+    put(box.max, info.box_max);
+    info.chunks_empty = s.chunks_empty;
+    info.chunks_solid = s.chunks_solid;
+    info.chunks_mixed = s.chunks_mixed;
+    info.points = s.points;
+    info.memory_bytes = s.memory_bytes;
+    info.edit_version = world->editor.version();
+    *out = info;
+    return LDC_OK;
+  });
+}
+
+int ldc_world_inside(const ldc_world* world, const double point[3]) {
+  if (!world || !point) return 0;
+  const glm::dvec3 p = vec3(point);
+  if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) return 0;
+  return world->world().inside(p) ? 1 : 0;
+}
+
+// ---------------------------------------------------------------------------
+// Edits
+
+static ldc::Result<ldc::Brush> to_brush(const ldc_brush& b) {
+  const int32_t shape = raw_enum(b.shape);
+  switch (shape) {
+    case LDC_BRUSH_SPHERE: return ldc::Brush::sphere(vec3(b.centre), b.radius, b.material);
+    case LDC_BRUSH_BOX: return ldc::Brush::box(vec3(b.centre), vec3(b.half_extents), b.material);
+    case LDC_BRUSH_CAPSULE: return ldc::Brush::capsule(vec3(b.a), vec3(b.b), b.radius, b.material);
+  }
+  return ldc::Status(ldc::ErrorCode::kInvalidArgument,
+                     "brush shape " + std::to_string(shape) + ": use sphere (0), box (1) or capsule (2)");
+}
+
+static ldc::Result<ldc::EditOp> to_op(int32_t op) {
+  switch (op) {
+    case LDC_EDIT_DIG: return ldc::EditOp::kSubtract;
+    case LDC_EDIT_BUILD: return ldc::EditOp::kAdd;
+    case LDC_EDIT_PAINT: return ldc::EditOp::kPaint;
+    case LDC_EDIT_INTERSECT: return ldc::EditOp::kIntersect;
+  }
+  return ldc::Status(ldc::ErrorCode::kInvalidArgument,
+                     "edit op " + std::to_string(op) + ": use dig (0), build (1), paint (2) or intersect (3)");
+}
+
+ldc_status ldc_world_edit(ldc_world* world, const ldc_brush* brush, ldc_edit_op op, ldc_edit_result* out) {
+  return guarded("ldc_world_edit", [&] {
+    if (!world) return null_argument("ldc_world_edit", "world");
+    if (!brush) return null_argument("ldc_world_edit", "brush");
+    ldc::Result<ldc::Brush> b = to_brush(*brush);
+    if (!b.ok()) return from_status(b.status());
+    ldc::Result<ldc::EditOp> o = to_op(raw_enum(op));
+    if (!o.ok()) return from_status(o.status());
+    ldc::Result<ldc::EditReceipt> receipt = world->editor.apply(b.value(), o.value());
+    if (!receipt.ok()) return from_status(receipt.status());
+    world->fan_out(world->editor.take_dirty());
+    if (out) {
+      out->version = receipt->version;
+      out->chunks_changed = receipt->changed_chunks.size();
+    }
+    return LDC_OK;
+  });
+}
+
+ldc_status ldc_world_take_dirty(ldc_world* world, ldc_dirty_chunk* out, size_t capacity, size_t* count) {
+  return guarded("ldc_world_take_dirty", [&] {
+    if (!world) return null_argument("ldc_world_take_dirty", "world");
+    if (!count) return null_argument("ldc_world_take_dirty", "count");
+    const size_t n = world->user_dirty.size();
+    *count = n;
+    if (!out) return LDC_OK;
+    if (capacity < n) {
+      return fail(LDC_BUFFER_TOO_SMALL, "ldc_world_take_dirty: " + std::to_string(n) +
+                                            " dirty chunks, capacity " + std::to_string(capacity));
+    }
+    size_t i = 0;
+    for (const auto& [key, d] : world->user_dirty) out[i++] = d;
+    world->user_dirty.clear();
+    return LDC_OK;
+  });
+}
+
+// ---------------------------------------------------------------------------
+// Meshing
+
+static ldc::Status sync_mesh(ldc_world* world) {
+  if (!world->mesh_built) {
+    world->mesh = ldc::ChunkedMesh(world->contour_config);
+    ldc::Status s = world->mesh.build(world->world());
+    if (!s.ok()) return s;
+    world->mesh_built = true;
+  } else if (!world->mesh_pending.empty()) {
+    ldc::Result<size_t> r = world->mesh.update(world->world(), world->mesh_pending);
+    if (!r.ok()) return r.status();
+  }
+  world->mesh_pending.clear();
+  return {};
+}
+
+static const ldc::ChunkMesh* find_chunk_mesh(const ldc::ChunkedMesh& mesh, const glm::ivec3& chunk) {
+  const std::vector<ldc::ChunkMesh>& all = mesh.chunks();
+  auto it = std::lower_bound(all.begin(), all.end(), key_of(chunk),
+                             [](const ldc::ChunkMesh& m, const ChunkKey& k) { return key_of(m.chunk) < k; });
+  return it != all.end() && it->chunk == chunk ? &*it : nullptr;
+}
+
+static void copy_mesh(const ldc::ContourMesh& m, ldc_mesh_buffers* b) {
+  for (size_t i = 0; i < m.vertex_count(); ++i) {
+    for (int k = 0; k < 3; ++k) b->positions[3 * i + k] = float(m.positions[i][k]);
+    if (b->normals) put(m.normals[i], b->normals + 3 * i);
+    if (b->vertex_materials) b->vertex_materials[i] = m.vertex_material[i];
+  }
+  for (size_t t = 0; t < m.triangle_count(); ++t) {
+    for (int k = 0; k < 3; ++k) b->indices[3 * t + k] = m.triangles[t][k];
+    if (b->triangle_materials) b->triangle_materials[t] = m.triangle_material[t];
+  }
+}
+
+ldc_status ldc_world_mesh_chunk(ldc_world* world, const int32_t chunk[3], ldc_mesh_buffers* buffers) {
+  return guarded("ldc_world_mesh_chunk", [&] {
+    if (!world) return null_argument("ldc_world_mesh_chunk", "world");
+    if (!chunk) return null_argument("ldc_world_mesh_chunk", "chunk");
+    if (!buffers) return null_argument("ldc_world_mesh_chunk", "buffers");
+    if (ldc_status s = from_status(sync_mesh(world)); s != LDC_OK) return s;
+    const ldc::ChunkMesh* cm = find_chunk_mesh(world->mesh, ivec3(chunk));
+    static const ldc::ContourMesh kEmpty;
+    const ldc::ContourMesh& m = cm ? cm->mesh : kEmpty;
+    buffers->vertex_count = m.vertex_count();
+    buffers->triangle_count = m.triangle_count();
+    if (!buffers->positions && !buffers->indices) return LDC_OK;  // size query
+    if (!buffers->positions || !buffers->indices) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_mesh_chunk: positions and indices must both be set "
+                                        "(or both NULL for a size query)");
+    }
+    if (buffers->vertex_capacity < m.vertex_count() || buffers->triangle_capacity < m.triangle_count()) {
+      return fail(LDC_BUFFER_TOO_SMALL,
+                  "ldc_world_mesh_chunk: chunk (" + std::to_string(chunk[0]) + ", " + std::to_string(chunk[1]) +
+                      ", " + std::to_string(chunk[2]) + ") has " + std::to_string(m.vertex_count()) +
+                      " vertices and " + std::to_string(m.triangle_count()) + " triangles; capacity " +
+                      std::to_string(buffers->vertex_capacity) + " and " +
+                      std::to_string(buffers->triangle_capacity));
+    }
+    copy_mesh(m, buffers);
+    return LDC_OK;
+  });
+}
+
+// ---------------------------------------------------------------------------
+// Ray casts
+
+ldc_status ldc_world_ray_cast(ldc_world* world, const ldc_ray* rays, size_t count, ldc_ray_hit* hits) {
+  return guarded("ldc_world_ray_cast", [&] {
+    if (!world) return null_argument("ldc_world_ray_cast", "world");
+    if (count == 0) return LDC_OK;
+    if (!rays) return null_argument("ldc_world_ray_cast", "rays");
+    if (!hits) return null_argument("ldc_world_ray_cast", "hits");
+    if (!world->queries) {
+      world->queries = std::make_unique<ldc::Queries>(world->world());
+    } else if (world->queries_stale) {
+      world->queries->refresh();
+    }
+    world->queries_stale = false;
+    std::vector<ldc::Ray> in(count);
+    for (size_t i = 0; i < count; ++i) {
+      in[i].origin = vec3(rays[i].origin);
+      in[i].direction = vec3(rays[i].direction);
+      in[i].max_distance = rays[i].max_distance;
+    }
+    std::vector<ldc::RayHit> out(count);
+    if (ldc_status s = from_status(world->queries->ray_cast(in, out)); s != LDC_OK) return s;
+    for (size_t i = 0; i < count; ++i) {
+      ldc_ray_hit h{};
+      h.hit = out[i].hit ? 1 : 0;
+      h.started_inside = out[i].started_inside ? 1 : 0;
+      h.distance = out[i].distance;
+      put(out[i].point, h.point);
+      put(out[i].normal, h.normal);
+      h.material = out[i].material;
+      hits[i] = h;
+    }
+    return LDC_OK;
+  });
+}
+
+// ---------------------------------------------------------------------------
+// Navigation
+
+void ldc_nav_config_default(ldc_nav_config* config) {
+  if (!config) return;
+  const ldc::NavConfig d;
+  *config = ldc_nav_config{};
+  config->up_axis = d.up_axis;
+  config->agent_height = d.agent_height;
+  config->agent_radius = d.agent_radius;
+  config->max_climb = d.max_climb;
+  config->max_slope_degrees = d.max_slope_degrees;
+  config->max_nodes = 2048;
+  put(ldc::PathQueryOptions{}.search_half_extents, config->search_half_extents);
+}
+
+ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* config) {
+  return guarded("ldc_world_set_nav_config", [&] {
+    if (!world) return null_argument("ldc_world_set_nav_config", "world");
+    if (!config) return null_argument("ldc_world_set_nav_config", "config");
+    ldc::NavConfig c;
+    c.up_axis = config->up_axis;
+    c.agent_height = config->agent_height;
+    c.agent_radius = config->agent_radius;
+    c.max_climb = config->max_climb;
+    c.max_slope_degrees = config->max_slope_degrees;
+    if (ldc_status s = from_status(ldc::check_nav_config(c, world->world())); s != LDC_OK) return s;
+    if (config->max_nodes < 16 || config->max_nodes > (1 << 20)) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_set_nav_config: max_nodes " +
+                                            std::to_string(config->max_nodes) + " must be in 16 .. 1048576");
+    }
+    const glm::dvec3 half = vec3(config->search_half_extents);
+    if (!(half.x > 0 && half.y > 0 && half.z > 0) || !std::isfinite(half.x + half.y + half.z)) {
+      return fail(LDC_INVALID_ARGUMENT,
+                  "ldc_world_set_nav_config: search_half_extents must be finite and > 0 on every axis");
+    }
+    world->nav_config = c;
+    world->max_nodes = config->max_nodes;
+    world->search_half_extents = half;
+    world->nav.reset();
+    world->nav_pending.clear();
+    return LDC_OK;
+  });
+}
+
+static ldc::Status sync_nav(ldc_world* world) {
+  if (!world->nav) {
+    ldc::Result<ldc::NavMesh> nav = ldc::NavMesh::build(world->world(), world->nav_config);
+    if (!nav.ok()) return nav.status();
+    world->nav.emplace(std::move(nav).value());
+  } else if (!world->nav_pending.empty()) {
+    ldc::Result<ldc::NavUpdateStats> r = world->nav->update(world->world(), world->nav_pending);
+    if (!r.ok()) return r.status();
+  }
+  world->nav_pending.clear();
+  return {};
+}
+
+ldc_status ldc_world_find_path(ldc_world* world, const double from[3], const double to[3], double* corners,
+                               size_t corner_capacity, ldc_path_info* info) {
+  return guarded("ldc_world_find_path", [&] {
+    if (!world) return null_argument("ldc_world_find_path", "world");
+    if (!from || !to) return null_argument("ldc_world_find_path", from ? "to" : "from");
+    if (!info) return null_argument("ldc_world_find_path", "info");
+    if (ldc_status s = from_status(sync_nav(world)); s != LDC_OK) return s;
+    ldc::NavQuery query(*world->nav, world->max_nodes);
+    ldc::PathQueryOptions options;
+    options.search_half_extents = world->search_half_extents;
+    ldc::Result<ldc::NavPath> path = query.find_path(vec3(from), vec3(to), options);
+    if (!path.ok()) {
+      const bool no_floor = path.status().message().find("no walkable floor") != std::string::npos;
+      return fail(no_floor ? LDC_NOT_FOUND : static_cast<ldc_status>(path.status().code()),
+                  path.status().message());
+    }
+    const ldc::NavPath& p = path.value();
+    ldc_path_info r{};
+    r.status = static_cast<ldc_path_status>(p.status);
+    r.corner_count = p.corners.size();
+    r.length = p.length;
+    r.nodes_searched = p.nodes_searched;
+    *info = r;
+    if (corners && corner_capacity < p.corners.size()) {
+      return fail(LDC_BUFFER_TOO_SMALL, "ldc_world_find_path: " + std::to_string(p.corners.size()) +
+                                            " corners, capacity " + std::to_string(corner_capacity));
+    }
+    if (corners) {
+      for (size_t i = 0; i < p.corners.size(); ++i) put(p.corners[i], corners + 3 * i);
+    }
+    return LDC_OK;
+  });
+}
+
+// ---------------------------------------------------------------------------
+// Cascades
+
+void ldc_cascade_config_default(ldc_cascade_config* config) {
+  if (!config) return;
+  const ldc::CascadeConfig d;
+  *config = ldc_cascade_config{};
+  config->levels = d.levels;
+  config->resolution = d.resolution;
+  config->voxel_size = d.voxel_size;
+}
+
+ldc_status ldc_cascades_create(ldc_world* world, const ldc_cascade_config* config, ldc_cascades** out) {
+  return guarded("ldc_cascades_create", [&] {
+    if (!world) return null_argument("ldc_cascades_create", "world");
+    if (!config) return null_argument("ldc_cascades_create", "config");
+    if (!out) return null_argument("ldc_cascades_create", "out");
+    ldc::CascadeConfig c;
+    c.levels = config->levels;
+    c.resolution = config->resolution;
+    c.voxel_size = config->voxel_size;
+    ldc::Result<ldc::Cascades> cascades = ldc::Cascades::create(world->world().lattice(), c);
+    if (!cascades.ok()) return from_status(cascades.status());
+    auto handle = std::make_unique<ldc_cascades>(ldc_cascades{world, std::move(cascades).value(), {}, {}});
+    world->cascades.push_back(handle.get());
+    *out = handle.release();
+    return LDC_OK;
+  });
+}
+
+void ldc_cascades_destroy(ldc_cascades* cascades) {
+  if (!cascades) return;
+  if (ldc_world* w = cascades->world) {
+    std::erase(w->cascades, cascades);
+  }
+  delete cascades;
+}
+
+ldc_status ldc_cascades_update_level(ldc_cascades* cascades, int32_t level, const double camera[3],
+                                     ldc_cascade_update* out) {
+  return guarded("ldc_cascades_update_level", [&] {
+    if (!cascades) return null_argument("ldc_cascades_update_level", "cascades");
+    if (!camera) return null_argument("ldc_cascades_update_level", "camera");
+    if (!cascades->world) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_cascades_update_level: the world these cascades were made "
+                                        "from has been destroyed");
+    }
+    ldc::Cascades& c = cascades->cascades;
+    if (level < 0 || level >= c.levels()) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_cascades_update_level: level " + std::to_string(level) +
+                                            " must be in 0 .. " + std::to_string(c.levels() - 1));
+    }
+    if (!cascades->pending.empty()) {
+      c.invalidate(cascades->pending);
+      cascades->pending.clear();
+    }
+    ldc::Result<ldc::CascadeUpdate> u = c.update_level(cascades->world->world(), level, vec3(camera));
+    if (!u.ok()) return from_status(u.status());
+    if (out) {
+      ldc_cascade_update r{};
+      r.level = u->level;
+      put(u->shift, r.shift);
+      r.full = u->full ? 1 : 0;
+      r.voxels = u->voxels;
+      r.seconds = u->seconds;
+      put(c.level_box(level).lo, r.box_lo);
+      put(c.level_box(level).dims, r.box_dims);
+      *out = r;
+    }
+    return LDC_OK;
+  });
+}
+
+ldc_status ldc_cascades_read_level(const ldc_cascades* cascades, int32_t level, ldc_gbuffer_buffers* buffers) {
+  return guarded("ldc_cascades_read_level", [&] {
+    if (!cascades) return null_argument("ldc_cascades_read_level", "cascades");
+    if (!buffers) return null_argument("ldc_cascades_read_level", "buffers");
+    const ldc::Cascades& c = cascades->cascades;
+    if (level < 0 || level >= c.levels()) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_cascades_read_level: level " + std::to_string(level) +
+                                            " must be in 0 .. " + std::to_string(c.levels() - 1));
+    }
+    const size_t n = size_t(c.resolution());
+    const size_t texels = size_t(ldc::kFaces) * n * n * n;
+    buffers->texel_count = texels;
+    ldc_gbuffer_buffers& b = *buffers;
+    if (!b.albedo && !b.normal && !b.occupancy && !b.emission) return LDC_OK;
+    if (b.texel_capacity < texels) {
+      return fail(LDC_BUFFER_TOO_SMALL, "ldc_cascades_read_level: " + std::to_string(texels) +
+                                            " texels, capacity " + std::to_string(b.texel_capacity));
+    }
+    ldc::PackedGBuffer& p = const_cast<ldc_cascades*>(cascades)->scratch;
+    c.pack_level(level, &p);
+    for (int f = 0; f < ldc::kFaces; ++f)
+      for (int z = 0; z < int(n); ++z)
+        for (int y = 0; y < int(n); ++y)
+          for (int x = 0; x < int(n); ++x) {
+            const size_t src = p.texel(f, level, {x, y, z});
+            const size_t dst = (size_t(z) * n + size_t(y)) * n * ldc::kFaces + size_t(f) * n + size_t(x);
+            if (b.albedo) b.albedo[dst] = p.albedo[src];
+            if (b.normal) b.normal[dst] = p.normal[src];
+            if (b.occupancy) b.occupancy[dst] = p.occupancy[src];
+            if (b.emission) b.emission[dst] = p.emission[src];
+          }
+    return LDC_OK;
+  });
+}
+
+}  // extern "C"

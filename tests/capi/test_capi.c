@@ -1,0 +1,462 @@
+/* The C API (capi/ldc.h) exercised from C: every call, its size queries, its
+ * refusals. Compiled as C11; run by ctest (label capi) and under ASan + UBSan
+ * by scripts/sanitize.sh. Usage: ldc_capi_test [scratch directory]. */
+#include "capi/ldc.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int g_failures = 0;
+static int g_checks = 0;
+static const char* g_case = "";
+
+#define CHECK(cond)                                                                     \
+  do {                                                                                  \
+    ++g_checks;                                                                         \
+    if (!(cond)) {                                                                      \
+      fprintf(stderr, "%s:%d: [%s] CHECK failed: %s (last error: %s)\n", __FILE__,     \
+              __LINE__, g_case, #cond, ldc_last_error());                               \
+      ++g_failures;                                                                     \
+    }                                                                                   \
+  } while (0)
+#define CHECK_STATUS(call, expected) CHECK((call) == (expected))
+
+static char g_dir[1024] = ".";
+
+/* A small landscape: 16 x 16 m at h = 0.25 m (cheap under ASan). */
+static ldc_world* small_landscape(void) {
+  ldc_terrain_config t;
+  ldc_terrain_config_default(&t);
+  t.size_x = 16.0;
+  t.size_y = 16.0;
+  t.cell_size = 0.25;
+  t.arches = 1;
+  ldc_world* w = NULL;
+  CHECK_STATUS(ldc_world_create_terrain(&t, &w), LDC_OK);
+  return w;
+}
+
+/* The ground height under (x, y): a ray cast straight down from high above. */
+static double ground_z(ldc_world* w, double x, double y) {
+  ldc_ray r = {{x, y, 100.0}, {0.0, 0.0, -1.0}, INFINITY};
+  ldc_ray_hit h;
+  if (ldc_world_ray_cast(w, &r, 1, &h) != LDC_OK || !h.hit) return NAN;
+  return h.point[2];
+}
+
+static void version_matches_the_header(void) {
+  g_case = "version_matches_the_header";
+  CHECK(strcmp(ldc_version_string(), LDC_VERSION_STRING) == 0);
+  CHECK(ldc_version() == LDC_VERSION);
+  CHECK(ldc_format_version() == LDC_FORMAT_VERSION);
+  CHECK(strcmp(ldc_status_name(LDC_OK), "ok") == 0);
+  CHECK(strcmp(ldc_status_name(LDC_BUFFER_TOO_SMALL), "buffer too small") == 0);
+  CHECK(strcmp(ldc_status_name(LDC_INVALID_ARGUMENT), "invalid argument") == 0);
+  CHECK(strcmp(ldc_status_name((ldc_status)12345), "unknown status") == 0);
+  CHECK(sizeof(ldc_status) == 4 && sizeof(ldc_brush_shape) == 4 && sizeof(ldc_edit_op) == 4);
+}
+
+static void null_handles_are_refused_by_name(void) {
+  g_case = "null_handles_are_refused_by_name";
+  ldc_world_info info;
+  CHECK_STATUS(ldc_world_get_info(NULL, &info), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "world is NULL") != NULL);
+  CHECK_STATUS(ldc_world_save(NULL, "x.ldc"), LDC_INVALID_ARGUMENT);
+  ldc_world_destroy(NULL);
+  ldc_cascades_destroy(NULL);
+}
+
+static void bad_world_config_is_refused(void) {
+  g_case = "bad_world_config_is_refused";
+  ldc_world_config c;
+  ldc_world_config_default(&c);
+  CHECK(c.chunk_size == 32 && c.cell_size == 0.2);
+  c.chunk_size = 33;
+  ldc_world* w = NULL;
+  CHECK_STATUS(ldc_world_create(&c, &w), LDC_INVALID_ARGUMENT);
+  CHECK(w == NULL);
+  CHECK(strstr(ldc_last_error(), "33") != NULL);
+  ldc_world_config_default(&c);
+  c.chunk_dims[0] = 2;
+  CHECK_STATUS(ldc_world_create(&c, &w), LDC_OK);
+  ldc_world_info info;
+  CHECK_STATUS(ldc_world_get_info(w, &info), LDC_OK);
+  CHECK(info.chunks_empty == 2 && info.points == 0);
+  ldc_world_destroy(w);
+}
+
+static void missing_file_is_named(void) {
+  g_case = "missing_file_is_named";
+  ldc_world* w = NULL;
+  CHECK(ldc_world_load("no-such-world.ldc", &w) != LDC_OK);
+  CHECK(w == NULL);
+  CHECK(strstr(ldc_last_error(), "no-such-world.ldc") != NULL);
+}
+
+static void save_and_load_keep_the_world(ldc_world* w) {
+  g_case = "save_and_load_keep_the_world";
+  char path[1200];
+  snprintf(path, sizeof path, "%s/capi_world.ldc", g_dir);
+  CHECK_STATUS(ldc_world_save(w, path), LDC_OK);
+  ldc_world* back = NULL;
+  CHECK_STATUS(ldc_world_load(path, &back), LDC_OK);
+  ldc_world_info a, b;
+  CHECK_STATUS(ldc_world_get_info(w, &a), LDC_OK);
+  CHECK_STATUS(ldc_world_get_info(back, &b), LDC_OK);
+  CHECK(a.points == b.points && a.points > 0);
+  CHECK(a.chunks_mixed == b.chunks_mixed && a.cell_size == b.cell_size);
+  ldc_world_destroy(back);
+  remove(path);
+}
+
+static void dig_build_and_paint_change_the_solid(ldc_world* w) {
+  g_case = "dig_build_and_paint_change_the_solid";
+  const double gz = ground_z(w, 8.0, 8.0);
+  CHECK(!isnan(gz));
+  const double below[3] = {8.0, 8.0, gz - 0.5};
+  CHECK(ldc_world_inside(w, below) == 1);
+  ldc_brush dig = {0};
+  dig.shape = LDC_BRUSH_SPHERE;
+  dig.centre[0] = 8.0, dig.centre[1] = 8.0, dig.centre[2] = gz;
+  dig.radius = 1.5;
+  ldc_edit_result r;
+  CHECK_STATUS(ldc_world_edit(w, &dig, LDC_EDIT_DIG, &r), LDC_OK);
+  CHECK(r.version == 1 && r.chunks_changed > 0);
+  CHECK(ldc_world_inside(w, below) == 0);
+
+  ldc_brush box = {0};
+  box.shape = LDC_BRUSH_BOX;
+  box.centre[0] = 4.0, box.centre[1] = 4.0, box.centre[2] = gz + 6.0;
+  box.half_extents[0] = box.half_extents[1] = box.half_extents[2] = 0.6;
+  box.material = 2;
+  CHECK_STATUS(ldc_world_edit(w, &box, LDC_EDIT_BUILD, NULL), LDC_OK);
+  CHECK(ldc_world_inside(w, box.centre) == 1);
+
+  ldc_brush paint = {0};
+  paint.shape = LDC_BRUSH_CAPSULE;
+  paint.a[0] = 2.0, paint.a[1] = 12.0, paint.a[2] = gz;
+  paint.b[0] = 6.0, paint.b[1] = 12.0, paint.b[2] = gz;
+  paint.radius = 8.0;
+  paint.material = 3;
+  CHECK_STATUS(ldc_world_edit(w, &paint, LDC_EDIT_PAINT, &r), LDC_OK);
+  CHECK(r.version == 3);
+  ldc_world_info info;
+  CHECK_STATUS(ldc_world_get_info(w, &info), LDC_OK);
+  CHECK(info.edit_version == 3);
+}
+
+static void bad_brush_leaves_the_world_unchanged(ldc_world* w) {
+  g_case = "bad_brush_leaves_the_world_unchanged";
+  ldc_world_info before, after;
+  CHECK_STATUS(ldc_world_get_info(w, &before), LDC_OK);
+  ldc_brush b = {0};
+  b.shape = LDC_BRUSH_SPHERE;
+  b.radius = -1.0;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_DIG, NULL), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "radius") != NULL);
+  b.radius = 1.0;
+  b.shape = (ldc_brush_shape)7;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_DIG, NULL), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "brush shape 7") != NULL);
+  b.shape = LDC_BRUSH_SPHERE;
+  CHECK_STATUS(ldc_world_edit(w, &b, (ldc_edit_op)9, NULL), LDC_INVALID_ARGUMENT);
+  CHECK_STATUS(ldc_world_get_info(w, &after), LDC_OK);
+  CHECK(after.edit_version == before.edit_version && after.points == before.points);
+}
+
+static void dirty_chunks_are_taken_once(ldc_world* w) {
+  g_case = "dirty_chunks_are_taken_once";
+  size_t n = 0;
+  CHECK_STATUS(ldc_world_take_dirty(w, NULL, 0, &n), LDC_OK); /* size query keeps the list */
+  CHECK(n > 0);
+  ldc_dirty_chunk one;
+  size_t m = 0;
+  if (n > 1) {
+    CHECK_STATUS(ldc_world_take_dirty(w, &one, 1, &m), LDC_BUFFER_TOO_SMALL);
+    CHECK(m == n);
+  }
+  ldc_dirty_chunk* all = calloc(n, sizeof *all);
+  CHECK_STATUS(ldc_world_take_dirty(w, all, n, &m), LDC_OK);
+  CHECK(m == n);
+  size_t data = 0;
+  for (size_t i = 0; i < m; ++i) {
+    CHECK((all[i].flags & LDC_DIRTY_MESH) != 0);
+    if (all[i].flags & LDC_DIRTY_DATA) {
+      ++data;
+      CHECK(all[i].version >= 1 && all[i].version <= 3);
+      CHECK(all[i].node_lo[0] < all[i].node_hi[0]);
+    }
+    if (i > 0) { /* sorted by (z, y, x) */
+      const int32_t* a = all[i - 1].chunk;
+      const int32_t* b = all[i].chunk;
+      CHECK(a[2] < b[2] || (a[2] == b[2] && (a[1] < b[1] || (a[1] == b[1] && a[0] < b[0]))));
+    }
+  }
+  CHECK(data > 0);
+  free(all);
+  CHECK_STATUS(ldc_world_take_dirty(w, NULL, 0, &n), LDC_OK);
+  CHECK(n == 0);
+}
+
+/* Meshes every chunk of the box; returns the total triangle count. */
+static size_t mesh_every_chunk(ldc_world* w) {
+  ldc_world_info info;
+  CHECK_STATUS(ldc_world_get_info(w, &info), LDC_OK);
+  size_t triangles = 0;
+  for (int z = 0; z < info.chunk_dims[2]; ++z)
+    for (int y = 0; y < info.chunk_dims[1]; ++y)
+      for (int x = 0; x < info.chunk_dims[0]; ++x) {
+        const int32_t c[3] = {info.chunk_origin[0] + x, info.chunk_origin[1] + y, info.chunk_origin[2] + z};
+        ldc_mesh_buffers b = {0};
+        CHECK_STATUS(ldc_world_mesh_chunk(w, c, &b), LDC_OK);
+        if (b.triangle_count == 0) continue;
+        const size_t nv = b.vertex_count, nt = b.triangle_count;
+        b.positions = malloc(nv * 3 * sizeof(float));
+        b.normals = malloc(nv * 3 * sizeof(float));
+        b.vertex_materials = malloc(nv * sizeof(uint16_t));
+        b.indices = malloc(nt * 3 * sizeof(uint32_t));
+        b.triangle_materials = NULL; /* not wanted */
+        b.vertex_capacity = nv;
+        b.triangle_capacity = nt - 1;
+        CHECK_STATUS(ldc_world_mesh_chunk(w, c, &b), LDC_BUFFER_TOO_SMALL);
+        b.triangle_capacity = nt;
+        CHECK_STATUS(ldc_world_mesh_chunk(w, c, &b), LDC_OK);
+        for (size_t i = 0; i < 3 * nt; ++i) CHECK(b.indices[i] < nv);
+        for (size_t i = 0; i < nv; ++i) {
+          const float* n = b.normals + 3 * i;
+          CHECK(fabsf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1.0f) < 1e-3f);
+          CHECK(b.positions[3 * i + 2] > info.box_min[2] - 1.0 && b.positions[3 * i + 2] < info.box_max[2] + 1.0);
+        }
+        triangles += nt;
+        free(b.positions), free(b.normals), free(b.vertex_materials), free(b.indices);
+      }
+  return triangles;
+}
+
+static void chunk_meshes_follow_the_edits(ldc_world* w) {
+  g_case = "chunk_meshes_follow_the_edits";
+  const size_t before = mesh_every_chunk(w);
+  CHECK(before > 1000);
+  ldc_brush b = {0};
+  b.shape = LDC_BRUSH_SPHERE;
+  b.centre[0] = 12.0, b.centre[1] = 4.0, b.centre[2] = ground_z(w, 12.0, 4.0) + 3.0;
+  b.radius = 1.2;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_BUILD, NULL), LDC_OK); /* a floating ball: more triangles */
+  const size_t after = mesh_every_chunk(w);
+  CHECK(after > before);
+  const int32_t outside[3] = {1000, 0, 0};
+  ldc_mesh_buffers e = {0};
+  CHECK_STATUS(ldc_world_mesh_chunk(w, outside, &e), LDC_OK);
+  CHECK(e.vertex_count == 0 && e.triangle_count == 0);
+}
+
+/* FNV-1a of one chunk's mesh (counts, positions, indices, materials). */
+static uint64_t mesh_hash(ldc_world* w, const int32_t c[3]) {
+  ldc_mesh_buffers b = {0};
+  CHECK_STATUS(ldc_world_mesh_chunk(w, c, &b), LDC_OK);
+  uint64_t h = 1469598103934665603ull ^ (uint64_t)b.vertex_count * 31u ^ (uint64_t)b.triangle_count;
+  if (b.triangle_count == 0) return h;
+  b.positions = malloc(b.vertex_count * 3 * sizeof(float));
+  b.indices = malloc(b.triangle_count * 3 * sizeof(uint32_t));
+  b.triangle_materials = malloc(b.triangle_count * sizeof(uint16_t));
+  b.vertex_capacity = b.vertex_count, b.triangle_capacity = b.triangle_count;
+  CHECK_STATUS(ldc_world_mesh_chunk(w, c, &b), LDC_OK);
+  const unsigned char* parts[3] = {(const unsigned char*)b.positions, (const unsigned char*)b.indices,
+                                   (const unsigned char*)b.triangle_materials};
+  const size_t sizes[3] = {b.vertex_count * 3 * sizeof(float), b.triangle_count * 3 * sizeof(uint32_t),
+                           b.triangle_count * sizeof(uint16_t)};
+  for (int p = 0; p < 3; ++p)
+    for (size_t i = 0; i < sizes[p]; ++i) h = (h ^ parts[p][i]) * 1099511628211ull;
+  free(b.positions), free(b.indices), free(b.triangle_materials);
+  return h;
+}
+
+/* Every chunk whose mesh an edit changes is in the dirty list with LDC_DIRTY_MESH. */
+static void changed_meshes_are_flagged_dirty(ldc_world* w) {
+  g_case = "changed_meshes_are_flagged_dirty";
+  ldc_world_info info;
+  CHECK_STATUS(ldc_world_get_info(w, &info), LDC_OK);
+  const size_t chunks = (size_t)info.chunk_dims[0] * info.chunk_dims[1] * info.chunk_dims[2];
+  uint64_t* before = calloc(chunks, sizeof *before);
+  size_t n = 0;
+  ldc_world_take_dirty(w, NULL, 0, &n);
+  ldc_dirty_chunk* skip = calloc(n + 1, sizeof *skip);
+  CHECK_STATUS(ldc_world_take_dirty(w, skip, n, &n), LDC_OK); /* start from a clean list */
+  free(skip);
+  for (size_t i = 0; i < chunks; ++i) {
+    const int32_t c[3] = {info.chunk_origin[0] + (int32_t)(i % info.chunk_dims[0]),
+                          info.chunk_origin[1] + (int32_t)(i / info.chunk_dims[0] % info.chunk_dims[1]),
+                          info.chunk_origin[2] + (int32_t)(i / info.chunk_dims[0] / info.chunk_dims[1])};
+    before[i] = mesh_hash(w, c);
+  }
+  /* A dig on a chunk corner (h = 0.25, C = 32: chunks are 8 m) touches up to eight chunks. */
+  ldc_brush b = {0};
+  b.shape = LDC_BRUSH_SPHERE;
+  b.centre[0] = 8.0, b.centre[1] = 8.0, b.centre[2] = ground_z(w, 8.5, 8.5);
+  b.radius = 1.0;
+  b.material = 1;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_BUILD, NULL), LDC_OK);
+  ldc_world_take_dirty(w, NULL, 0, &n);
+  ldc_dirty_chunk* dirty = calloc(n + 1, sizeof *dirty);
+  CHECK_STATUS(ldc_world_take_dirty(w, dirty, n, &n), LDC_OK);
+  size_t changed = 0;
+  for (size_t i = 0; i < chunks; ++i) {
+    const int32_t c[3] = {info.chunk_origin[0] + (int32_t)(i % info.chunk_dims[0]),
+                          info.chunk_origin[1] + (int32_t)(i / info.chunk_dims[0] % info.chunk_dims[1]),
+                          info.chunk_origin[2] + (int32_t)(i / info.chunk_dims[0] / info.chunk_dims[1])};
+    if (mesh_hash(w, c) == before[i]) continue;
+    ++changed;
+    int flagged = 0;
+    for (size_t k = 0; k < n; ++k) {
+      flagged |= dirty[k].chunk[0] == c[0] && dirty[k].chunk[1] == c[1] && dirty[k].chunk[2] == c[2] &&
+                 (dirty[k].flags & LDC_DIRTY_MESH);
+    }
+    CHECK(flagged);
+  }
+  CHECK(changed >= 2);
+  free(before);
+  free(dirty);
+}
+
+static void ray_casts_find_the_ground(ldc_world* w) {
+  g_case = "ray_casts_find_the_ground";
+  ldc_ray rays[3] = {
+      {{3.0, 3.0, 50.0}, {0.0, 0.0, -1.0}, INFINITY},
+      {{3.0, 3.0, 50.0}, {0.0, 0.0, 1.0}, INFINITY}, /* up: misses */
+      {{3.0, 3.0, 50.0}, {0.0, 0.0, -2.0}, 1.0},     /* too short */
+  };
+  ldc_ray_hit hits[3];
+  CHECK_STATUS(ldc_world_ray_cast(w, rays, 3, hits), LDC_OK);
+  CHECK(hits[0].hit == 1 && hits[0].normal[2] > 0.0f && hits[0].point[2] < 20.0);
+  CHECK(fabs(hits[0].distance - (50.0 - hits[0].point[2])) < 1e-9);
+  CHECK(hits[1].hit == 0 && hits[2].hit == 0);
+  rays[1].direction[2] = 0.0;
+  CHECK_STATUS(ldc_world_ray_cast(w, rays, 3, hits), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "1") != NULL);
+  CHECK_STATUS(ldc_world_ray_cast(w, NULL, 0, NULL), LDC_OK);
+}
+
+static void paths_cross_the_landscape(ldc_world* w) {
+  g_case = "paths_cross_the_landscape";
+  ldc_nav_config nav;
+  ldc_nav_config_default(&nav);
+  CHECK(nav.agent_height == 2.0 && nav.max_nodes == 2048);
+  nav.agent_radius = 0.25;
+  CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_OK);
+  const double from[3] = {3.0, 5.0, ground_z(w, 3.0, 5.0) + 0.3};
+  const double to[3] = {13.0, 11.0, ground_z(w, 13.0, 11.0) + 0.3};
+  ldc_path_info info;
+  CHECK_STATUS(ldc_world_find_path(w, from, to, NULL, 0, &info), LDC_OK);
+  CHECK(info.corner_count >= 2 && info.length > 0.0);
+  double small[3];
+  if (info.corner_count > 1) {
+    CHECK_STATUS(ldc_world_find_path(w, from, to, small, 1, &info), LDC_BUFFER_TOO_SMALL);
+  }
+  double* corners = malloc(info.corner_count * 3 * sizeof(double));
+  CHECK_STATUS(ldc_world_find_path(w, from, to, corners, info.corner_count, &info), LDC_OK);
+  CHECK(fabs(corners[0] - from[0]) < 1.0 && fabs(corners[1] - from[1]) < 1.0);
+  free(corners);
+  const double sky[3] = {8.0, 8.0, 90.0};
+  CHECK_STATUS(ldc_world_find_path(w, sky, to, NULL, 0, &info), LDC_NOT_FOUND);
+  nav.max_slope_degrees = 95.0;
+  CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "max_slope") != NULL);
+  /* The navigation data follows edits: a deep pit under the goal leaves no floor near it. */
+  ldc_brush pit = {0};
+  pit.shape = LDC_BRUSH_BOX;
+  pit.centre[0] = to[0], pit.centre[1] = to[1], pit.centre[2] = to[2] - 3.0;
+  pit.half_extents[0] = pit.half_extents[1] = 3.0;
+  pit.half_extents[2] = 12.0;
+  CHECK_STATUS(ldc_world_edit(w, &pit, LDC_EDIT_DIG, NULL), LDC_OK);
+  ldc_path_info after;
+  const ldc_status s = ldc_world_find_path(w, from, to, NULL, 0, &after);
+  CHECK(s == LDC_NOT_FOUND || (s == LDC_OK && after.status != LDC_PATH_COMPLETE));
+}
+
+static void cascades_voxelize_a_level(ldc_world* w) {
+  g_case = "cascades_voxelize_a_level";
+  ldc_cascade_config c;
+  ldc_cascade_config_default(&c);
+  c.levels = 2;
+  c.resolution = 16;
+  c.voxel_size = 0.5;
+  ldc_cascades* cas = NULL;
+  CHECK_STATUS(ldc_cascades_create(w, &c, &cas), LDC_OK);
+  const double camera[3] = {8.0, 8.0, ground_z(w, 8.0, 8.0)};
+  ldc_cascade_update u;
+  CHECK_STATUS(ldc_cascades_update_level(cas, 0, camera, &u), LDC_OK);
+  CHECK(u.level == 0 && u.full == 1 && u.voxels == 16 * 16 * 16 && u.box_dims[0] == 16);
+  CHECK_STATUS(ldc_cascades_update_level(cas, 2, camera, &u), LDC_INVALID_ARGUMENT);
+  ldc_gbuffer_buffers g = {0};
+  CHECK_STATUS(ldc_cascades_read_level(cas, 0, &g), LDC_OK);
+  CHECK(g.texel_count == 6 * 16 * 16 * 16);
+  g.occupancy = malloc(g.texel_count);
+  g.albedo = malloc(g.texel_count * sizeof(uint32_t));
+  g.texel_capacity = g.texel_count;
+  CHECK_STATUS(ldc_cascades_read_level(cas, 0, &g), LDC_OK);
+  size_t solid = 0, seen = 0;
+  for (size_t i = 0; i < g.texel_count; ++i) {
+    solid += g.occupancy[i] > 0;
+    seen += (g.albedo[i] >> 24) > 0;
+  }
+  CHECK(solid > 0 && solid < g.texel_count && seen > 0);
+  /* An edit under the camera is picked up by the next update. */
+  ldc_brush b = {0};
+  b.shape = LDC_BRUSH_SPHERE;
+  b.centre[0] = camera[0], b.centre[1] = camera[1], b.centre[2] = camera[2];
+  b.radius = 2.0;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_DIG, NULL), LDC_OK);
+  CHECK_STATUS(ldc_cascades_update_level(cas, 0, camera, &u), LDC_OK);
+  CHECK(u.full == 0 && u.voxels > 0);
+  free(g.occupancy);
+  free(g.albedo);
+  ldc_cascades_destroy(cas);
+}
+
+static void cascades_outliving_their_world_refuse_updates(void) {
+  g_case = "cascades_outliving_their_world_refuse_updates";
+  ldc_world_config wc;
+  ldc_world_config_default(&wc);
+  ldc_world* w = NULL;
+  CHECK_STATUS(ldc_world_create(&wc, &w), LDC_OK);
+  ldc_cascade_config c;
+  ldc_cascade_config_default(&c);
+  c.levels = 1;
+  c.resolution = 8;
+  ldc_cascades* cas = NULL;
+  CHECK_STATUS(ldc_cascades_create(w, &c, &cas), LDC_OK);
+  ldc_world_destroy(w);
+  const double camera[3] = {0, 0, 0};
+  CHECK_STATUS(ldc_cascades_update_level(cas, 0, camera, NULL), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "destroyed") != NULL);
+  ldc_cascades_destroy(cas);
+}
+
+int main(int argc, char** argv) {
+  if (argc > 1) snprintf(g_dir, sizeof g_dir, "%s", argv[1]);
+  version_matches_the_header();
+  null_handles_are_refused_by_name();
+  bad_world_config_is_refused();
+  missing_file_is_named();
+  ldc_world* w = small_landscape();
+  if (!w) return 1;
+  save_and_load_keep_the_world(w);
+  dig_build_and_paint_change_the_solid(w);
+  bad_brush_leaves_the_world_unchanged(w);
+  dirty_chunks_are_taken_once(w);
+  chunk_meshes_follow_the_edits(w);
+  changed_meshes_are_flagged_dirty(w);
+  ray_casts_find_the_ground(w);
+  paths_cross_the_landscape(w);
+  cascades_voxelize_a_level(w);
+  ldc_world_destroy(w);
+  cascades_outliving_their_world_refuse_updates();
+  if (g_failures) {
+    fprintf(stderr, "test_capi: %d checks failed\n", g_failures);
+    return 1;
+  }
+  printf("test_capi: all %d checks passed (ldc %s, C API %d)\n", g_checks, ldc_version_string(), LDC_C_API_VERSION);
+  return 0;
+}

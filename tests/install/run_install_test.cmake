@@ -1,0 +1,61 @@
+# Installs the build into a scratch prefix, checks that the installed public
+# headers include nothing from CGAL, OpenVDB, Embree or ldc's detail/
+# folders, then configures, builds and runs tests/install/consumer against
+# the package with find_package(ldc). Run by ctest (label install):
+#   cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -P run_install_test.cmake
+foreach(var BUILD_DIR CONSUMER_DIR WORK_DIR)
+  if(NOT ${var})
+    message(FATAL_ERROR "run_install_test.cmake: -D${var}= is required")
+  endif()
+endforeach()
+if(NOT GENERATOR)
+  set(GENERATOR Ninja)
+endif()
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${ARGN}\n${out}\n${err}")
+  endif()
+  message("${out}")
+endfunction()
+
+file(REMOVE_RECURSE ${WORK_DIR})
+set(prefix ${WORK_DIR}/prefix)
+run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+
+# Public headers only, and none that drags in a heavy or internal header.
+file(GLOB_RECURSE headers ${prefix}/include/*.h)
+list(LENGTH headers header_count)
+if(header_count EQUAL 0)
+  message(FATAL_ERROR "no headers installed under ${prefix}/include")
+endif()
+foreach(h ${headers})
+  if(h MATCHES "/detail/")
+    message(FATAL_ERROR "an internal header was installed: ${h}")
+  endif()
+  file(STRINGS ${h} includes REGEX "^[ \t]*#[ \t]*include")
+  foreach(line ${includes})
+    if(line MATCHES "CGAL/|openvdb/|embree|/detail/")
+      message(FATAL_ERROR "${h} includes a header that must stay out of the public API: ${line}")
+    endif()
+  endforeach()
+endforeach()
+message("installed ${header_count} public headers; none includes CGAL, OpenVDB, Embree or detail/")
+if(NOT EXISTS ${prefix}/lib/cmake/ldc/ldcConfig.cmake AND NOT EXISTS ${prefix}/lib64/cmake/ldc/ldcConfig.cmake)
+  message(FATAL_ERROR "ldcConfig.cmake was not installed under ${prefix}/lib/cmake/ldc")
+endif()
+
+set(build ${WORK_DIR}/build)
+set(compilers)
+if(C_COMPILER)
+  list(APPEND compilers -DCMAKE_C_COMPILER=${C_COMPILER})
+endif()
+if(CXX_COMPILER)
+  list(APPEND compilers -DCMAKE_CXX_COMPILER=${CXX_COMPILER})
+endif()
+run(${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${build} -G ${GENERATOR} -DCMAKE_BUILD_TYPE=Release
+    -DCMAKE_PREFIX_PATH=${prefix} ${compilers})
+run(${CMAKE_COMMAND} --build ${build})
+run(${build}/consumer)
+run(${build}/consumer_c)
