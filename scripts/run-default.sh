@@ -10,6 +10,8 @@
 # and `ldc render` draws the dug landscape from the south-east as
 # out/tunnel.png (one ray cast per pixel, with shadows) with that path on top:
 # dashed where the ground hides it (docs/images/default-landscape.png is a copy).
+# Finally `ldc gi` lights the same view by cone tracing through the voxel cascades
+# (Vulkan; lavapipe without a GPU) and writes out/tunnel-gi.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -22,3 +24,5 @@ mkdir -p out
 ./build/tools/ldc path out/tunnel.ldc --from 47,10,2 --to 24,7.5,2 -o out/path.json
 ./build/tools/ldc render out/tunnel.ldc -o out/tunnel.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
   --width 960 --height 540 --shadows --overlay out/path.json
+./build/tools/ldc gi out/tunnel.ldc -o out/tunnel-gi.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
+  --width 480 --height 270
