@@ -13,6 +13,7 @@ using glm::ivec3;
 using glm::ivec4;
 using glm::vec3;
 using glm::vec4;
+using glm::abs;
 using glm::clamp;
 using glm::dot;
 using glm::exp;
