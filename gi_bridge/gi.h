@@ -17,7 +17,10 @@
 // voxel is the largest not wider than the cone (at least the start level),
 // moving to a coarser level where the position leaves a level's box; at each
 // step the 8-voxel trilinear sample gives an opacity a (the faces looking
-// back at the apex, weighted by d_axis^2) and light premultiplied by opacity,
+// back at the apex, weighted by d_axis^2; a corner counts only when its
+// voxel lies wholly ahead of the plane through the apex normal to the axis,
+// so a cone never reads the coarse voxel holding its own surface) and light
+// premultiplied by opacity,
 // composited front to back as in volume ray marching (opacity corrected for
 // the half-voxel step: 1 - sqrt(1 - a)). A cone that leaves the coarsest
 // level receives the sky times its transmittance.
