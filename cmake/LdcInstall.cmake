@@ -48,9 +48,13 @@ if(TARGET ldc_c)
   set_target_properties(ldc_c PROPERTIES EXPORT_NAME c)
   install(FILES capi/ldc.h DESTINATION ${ldc_header_dir}/capi COMPONENT dev)
 endif()
-# gi_bridge/ (issue 8) hook: when it defines target ldc_gi (LDC_WITH_VULKAN),
-# it is exported as ldc::gi and ldcConfig.cmake finds Vulkan for it. Its
-# public header(s) go to ${ldc_header_dir}/gi_bridge: add them here.
+# gi_bridge/ (issue 8): the CPU engine ldc::gi_cpu always, and the Vulkan
+# engine ldc::gi when it was built (LDC_WITH_VULKAN); ldcConfig.cmake then
+# finds Vulkan for it. The Embree path tracer (ldc_gi_reference) is a test
+# and benchmark tool and is not installed.
+list(APPEND ldc_export_targets ldc_gi_cpu)
+set_target_properties(ldc_gi_cpu PROPERTIES EXPORT_NAME gi_cpu)
+install(FILES gi_bridge/gi.h DESTINATION ${ldc_header_dir}/gi_bridge COMPONENT dev)
 set(LDC_PACKAGE_HAS_GI OFF)
 if(TARGET ldc_gi)
   set(LDC_PACKAGE_HAS_GI ON)

@@ -44,6 +44,10 @@ mkdir -p docs
   echo "## Voxel export against OpenVDB's solid voxelization (issue 7)"
   echo
   ./build/bench/bench_voxelize
+  echo
+  echo "## Cone-traced GI against a path-traced reference (issue 8)"
+  echo
+  if [ -x ./build/bench/bench_gi ]; then ./build/bench/bench_gi; else echo "(bench_gi not built: needs LDC_WITH_VULKAN and Embree)"; fi
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"

@@ -17,6 +17,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
   # benchmark peers (Embree: also the ray-cast agreement tests; Recast/Detour: bench_nav)
   libopenvdb-dev libboost-iostreams-dev libembree-dev librecast-dev
+  # gi_bridge (issue 8): Vulkan loader and headers, Mesa's lavapipe (CPU Vulkan), glslc
+  libvulkan-dev mesa-vulkan-drivers glslc
 )
 
 SUDO=""

@@ -14,6 +14,8 @@
 # or a build, re-mesh, nav update, an agent re-planning, ground ray casts) and
 # prints the per-frame timings as a table with median, p95 and max; four of
 # its frames are rendered to out/game_loop/frame_*.png.
+# Finally `ldc gi` lights the same view by cone tracing through the voxel cascades
+# (Vulkan; lavapipe without a GPU) and writes out/tunnel-gi.png.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
@@ -27,3 +29,5 @@ mkdir -p out
 ./build/tools/ldc render out/tunnel.ldc -o out/tunnel.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
   --width 960 --height 540 --shadows --overlay out/path.json
 ./build/examples/game_loop/game_loop --frames 60 --png out/game_loop
+./build/tools/ldc gi out/tunnel.ldc -o out/tunnel-gi.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
+  --width 480 --height 270

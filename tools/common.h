@@ -81,6 +81,7 @@ void add_boolean_command(CLI::App& app, CommonOptions& common);
 void add_edit_command(CLI::App& app, CommonOptions& common);
 void add_raycast_command(CLI::App& app, CommonOptions& common);
 void add_render_command(CLI::App& app, CommonOptions& common);
+void add_gi_command(CLI::App& app, CommonOptions& common);
 void add_path_command(CLI::App& app, CommonOptions& common);
 void add_voxelize_command(CLI::App& app, CommonOptions& common);
 

@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   ldc::tool::add_edit_command(app, common);
   ldc::tool::add_raycast_command(app, common);
   ldc::tool::add_render_command(app, common);
+  ldc::tool::add_gi_command(app, common);
   ldc::tool::add_path_command(app, common);
   ldc::tool::add_voxelize_command(app, common);
   try {

@@ -1,0 +1,251 @@
+// GI benchmark (issue 8): the Vulkan cone tracer (lavapipe here: no GPU is
+// lent to this machine) on three scenes — a Cornell-like box of primitives
+// open to the sky with an emitter and a point light, the default landscape
+// with a dug cave, and one shared mesh (spot) on a ground slab — with six
+// levels of 32^3 voxels: time per level update and per full update (with
+// and without the precombined buffers), a staggered frame, and the error of
+// the cone-traced irradiance against the path-traced reference (Embree on
+// the contoured mesh) at the same points, for 1, 2 and 3 bounces.
+// Usage: bench_gi [points (200)] [paths per point (512)]
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "contour/contour.h"
+#include "csg/csg.h"
+#include "gi_bridge/gi.h"
+#include "gi_bridge/path_trace.h"
+#include "ldc/build.h"
+#include "ldc/mesh.h"
+#include "ldc/terrain.h"
+
+namespace {
+
+using namespace ldc;
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct Scene {
+  std::string name;
+  World world;
+  glm::dvec3 camera;
+  GiLights lights;
+  MaterialTable materials;
+};
+
+void add_box(TriangleMesh& m, glm::dvec3 lo, glm::dvec3 hi, uint16_t mat) {
+  const uint32_t b = uint32_t(m.positions.size());
+  for (int i = 0; i < 8; ++i) m.positions.emplace_back(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+  const uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : q) {
+    m.triangles.emplace_back(b + f[0], b + f[1], b + f[2]);
+    m.triangles.emplace_back(b + f[0], b + f[2], b + f[3]);
+    m.triangle_material.insert(m.triangle_material.end(), {mat, mat});
+  }
+}
+
+World build(const TriangleMesh& m, double h) {
+  GridConfig g;
+  g.cell_size = h;
+  g.use_origin = true;
+  Result<World> w = build_from_mesh(m, g);
+  if (!w.ok()) {
+    std::fprintf(stderr, "build: %s\n", w.status().message().c_str());
+    std::exit(1);
+  }
+  return std::move(w).value();
+}
+
+MaterialTable cornell_materials() {
+  MaterialTable t;
+  t.materials = {{glm::vec3(0.75f), glm::vec3(0.0f)},
+                 {glm::vec3(0.75f, 0.15f, 0.12f), glm::vec3(0.0f)},
+                 {glm::vec3(0.15f, 0.7f, 0.15f), glm::vec3(0.0f)},
+                 {glm::vec3(0.75f), glm::vec3(6.0f)}};
+  return t;
+}
+
+Scene cornell() {
+  TriangleMesh m;
+  add_box(m, {-1.6, -1.6, -1.6}, {1.6, 1.6, -0.8}, 0);  // floor
+  add_box(m, {-1.6, -1.6, 0.8}, {1.6, 1.6, 1.6}, 0);    // ceiling
+  add_box(m, {-1.6, 0.8, -1.6}, {1.6, 1.6, 1.6}, 0);    // back
+  add_box(m, {-1.6, -1.6, -1.6}, {-0.8, 1.6, 1.6}, 1);  // red left
+  add_box(m, {0.8, -1.6, -1.6}, {1.6, 1.6, 1.6}, 2);    // green right
+  add_box(m, {-0.3, -0.3, 0.6}, {0.3, 0.3, 0.8}, 3);    // emitter under the ceiling
+  add_box(m, {-0.5, -0.1, -0.8}, {-0.1, 0.3, -0.2}, 0);  // tall block
+  add_box(m, {0.1, -0.5, -0.8}, {0.5, -0.1, -0.5}, 0);   // short block
+  Scene s{"cornell box (primitives)", build(m, 0.05), {0.0, -0.4, 0.0}, {}, cornell_materials()};
+  s.lights.sky = SkyLight::gradient(glm::vec3(0.8f, 0.9f, 1.2f), glm::vec3(1.0f), glm::vec3(0.3f));
+  s.lights.points.push_back({glm::dvec3(0.3, 0.2, 0.2), glm::vec3(0.8f, 0.7f, 0.5f)});
+  return s;
+}
+
+Scene landscape() {
+  Result<World> w = build_terrain(TerrainConfig{}, 0.2);
+  if (!w.ok()) std::exit(1);
+  WorldEditor ed(std::move(w).value());
+  // A cave: a chamber dug into the hillside, open at one end.
+  (void)ed.apply(Brush::capsule({14, 24, 4.0}, {24, 24, 4.0}, 2.0), EditOp::kSubtract);
+  (void)ed.apply(Brush::sphere({24, 24, 4.0}, 3.0), EditOp::kSubtract);
+  Scene s{"default landscape, dug cave", ed.world(), {24, 22, 5.0}, {}, default_material_table()};
+  s.lights.sky = SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f));
+  s.lights.points.push_back({glm::dvec3(24, 24, 4.5), glm::vec3(4.0f, 3.0f, 2.0f)});
+  return s;
+}
+
+Scene shared_mesh() {
+  Result<TriangleMesh> spot = load_mesh(std::string(LDC_BENCH_DATA_DIR) + "/spot.obj");
+  if (!spot.ok()) std::exit(1);
+  TriangleMesh m = std::move(spot).value();
+  for (glm::dvec3& p : m.positions) p = glm::dvec3(p.x * 2.0, p.z * 2.0, p.y * 2.0 + 1.45);  // y up -> z up, 2x
+  m.triangle_material.assign(m.triangles.size(), 0);
+  add_box(m, {-8, -8, -0.6}, {8, 8, 0.0}, 1);
+  Scene s{"shared mesh (spot) on a slab", build(m, 0.05), {0.0, -1.0, 1.0}, {}, cornell_materials()};
+  s.lights.sky = SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f));
+  return s;
+}
+
+// Query points: random triangles of the contoured mesh within `radius` of the camera.
+void query_points(const ContourMesh& mesh, const glm::dvec3& c, double radius, int count, std::vector<glm::dvec3>& p,
+                  std::vector<glm::vec3>& n) {
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<size_t> pick(0, mesh.triangles.size() - 1);
+  for (int tries = 0; int(p.size()) < count && tries < count * 2000; ++tries) {
+    const glm::uvec3 t = mesh.triangles[pick(rng)];
+    const glm::dvec3 a = mesh.positions[t.x], b = mesh.positions[t.y], d = mesh.positions[t.z];
+    const glm::dvec3 x = (a + b + d) / 3.0;
+    const glm::dvec3 cr = glm::cross(b - a, d - a);
+    if (glm::length(x - c) > radius || glm::length(cr) <= 1e-12) continue;
+    p.push_back(x);
+    n.emplace_back(glm::normalize(cr));
+  }
+}
+
+float lum(const glm::vec3& v) { return (v.x + v.y + v.z) / 3.0f; }
+
+struct Stats {
+  double mean = 0, p95 = 0;
+};
+Stats rel_error(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& ref) {
+  std::vector<double> e;
+  double scale = 0;
+  for (const glm::vec3& r : ref) scale += lum(r);
+  scale /= double(std::max<size_t>(1, ref.size()));
+  for (size_t i = 0; i < a.size(); ++i) {
+    // Relative to the point's reference, floored at 5% of the scene's mean (dark corners).
+    const double d = std::max(double(lum(ref[i])), 0.05 * scale);
+    e.push_back(std::abs(double(lum(a[i]) - lum(ref[i]))) / d);
+  }
+  std::sort(e.begin(), e.end());
+  Stats st;
+  for (double x : e) st.mean += x / double(e.size());
+  st.p95 = e.empty() ? 0 : e[std::min(e.size() - 1, size_t(0.95 * double(e.size())))];
+  return st;
+}
+
+void run(const Scene& s, int points, int paths) {
+  std::printf("\n## %s\n", s.name.c_str());
+  CascadeConfig cc;
+  cc.levels = 6;
+  cc.resolution = 32;
+  cc.voxel_size = s.world.lattice().cell_size * std::max(1.0, std::round(0.1 / s.world.lattice().cell_size));
+  cc.materials = s.materials;
+  Result<Cascades> cas = Cascades::create(s.world.lattice(), cc);
+  if (!cas.ok() || !cas.value().update_all(s.world, s.camera).ok()) {
+    std::printf("cascades failed\n");
+    return;
+  }
+  std::string device;
+  std::vector<glm::vec3> gi_e[3];
+  Result<ContourMesh> mesh = contour_world(s.world);
+  if (!mesh.ok()) return;
+  std::vector<glm::dvec3> p;
+  std::vector<glm::vec3> n;
+  query_points(mesh.value(), s.camera, 1.5, points, p, n);
+  std::printf("cascades: 6 levels of 32^3, level 0 voxel %.3g m; %zu query points within 1.5 m of the camera\n",
+              cc.voxel_size, p.size());
+  std::printf("| engine | precombined | load s | level 0 s | level 1 s | level 2 s | level 3 s | level 4 s | level 5 s | full update s | staggered frame s (mean of 16) | surface voxels |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  // Vulkan (lavapipe here) with and without the precombined buffers, then the CPU engine for reference.
+  for (int run_i = 0; run_i < 3; ++run_i) {
+    const bool pre = run_i != 1, cpu = run_i == 2;
+    GiConfig gc;
+    gc.precombined = pre;
+    std::unique_ptr<GiEngine> engine;
+    if (cpu) {
+      engine = make_cpu_gi(gc);
+    } else {
+      Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi(gc, &device);
+      if (!gi.ok()) {
+        std::printf("no Vulkan device: %s\n", gi.status().message().c_str());
+        return;
+      }
+      engine = std::move(gi).value();
+    }
+    GiEngine& g = *engine;
+    auto t0 = Clock::now();
+    if (!g.load(cas.value(), s.lights).ok()) return;
+    const double load_s = since(t0);
+    std::printf("| %s | %s | %.3f |", cpu ? "cpu (2 threads)" : "vulkan", pre ? "on" : "off", load_s);
+    size_t surf = 0;
+    for (int l = 0; l < 6; ++l) {
+      Result<GiTimings> t = g.update_level(l);
+      std::printf(" %.4f |", t.ok() ? t.value().seconds : -1.0);
+      if (t.ok()) surf += t.value().surface_voxels;
+    }
+    Result<GiTimings> full = g.update_all(1);
+    (void)g.update_all(1);
+    double frames = 0;
+    for (int f = 0; f < 16; ++f) {
+      Result<GiTimings> t = g.frame();
+      if (t.ok()) frames += t.value().seconds / 16.0;
+    }
+    std::printf(" %.4f | %.4f | %zu |\n", full.ok() ? full.value().seconds : -1.0, frames, surf);
+    if (pre && !cpu) {
+      (void)g.update_all(3);
+      for (int b = 1; b <= 3; ++b) {
+        gi_e[b - 1].resize(p.size());
+        (void)g.irradiance(p, n, b, gi_e[b - 1]);
+      }
+      t0 = Clock::now();
+      std::vector<glm::vec3> tmp(p.size());
+      (void)g.irradiance(p, n, 3, tmp);
+      std::printf("(irradiance query of %zu points: %.4f s)\n", p.size(), since(t0));
+    }
+  }
+  std::printf("device: %s\n", device.c_str());
+  Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), s.materials, s.lights);
+  if (!pt.ok()) return;
+  std::printf("| bounces | mean rel. error | p95 rel. error | mean cone-traced | mean path-traced | path tracer s | path samples |\n|---|---|---|---|---|---|---|\n");
+  for (int b = 1; b <= 3; ++b) {
+    std::vector<glm::vec3> ref(p.size());
+    PathTraceConfig pc;
+    pc.samples = paths;
+    const auto t0 = Clock::now();
+    (void)pt.value()->irradiance(p, n, b, ref, pc);
+    const double pt_s = since(t0);
+    const Stats st = rel_error(gi_e[b - 1], ref);
+    double mg = 0, mr = 0;
+    for (size_t i = 0; i < p.size(); ++i) mg += lum(gi_e[b - 1][i]) / double(p.size()), mr += lum(ref[i]) / double(p.size());
+    std::printf("| %d | %.1f%% | %.1f%% | %.3f | %.3f | %.2f | %d paths x %zu points |\n", b, 100 * st.mean, 100 * st.p95, mg,
+                mr, pt_s, paths, p.size());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int points = argc > 1 ? std::atoi(argv[1]) : 200;
+  const int paths = argc > 2 ? std::atoi(argv[2]) : 512;
+  std::printf("# bench_gi: cone-traced GI (Vulkan; lavapipe on this machine, no NVIDIA GPU lent) vs path-traced reference\n");
+  std::printf("No NVIDIA GPU was lent to this task: every Vulkan time below is Mesa's lavapipe (CPU), not a GPU.\n");
+  run(cornell(), points, paths);
+  run(landscape(), points, paths);
+  run(shared_mesh(), points, paths);
+  return 0;
+}

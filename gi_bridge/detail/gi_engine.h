@@ -1,0 +1,82 @@
+// Internals shared by the CPU and Vulkan engines: the flat buffers both
+// upload (layouts in shaders/gi_common.glsl) and the frame logic on top of
+// a small set of backend primitives.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "gi_bridge/gi.h"
+
+namespace ldc::detail {
+
+// std140 twin of the shaders' uniform block Params.
+struct GiParams {
+  glm::vec4 dirs[16];
+  glm::vec4 sky[16];
+  glm::vec4 light_pos[kGiMaxPointLights];
+  glm::vec4 light_int[kGiMaxPointLights];
+  glm::vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset, w RBF sharpness
+  glm::ivec4 iparams;  // x N, y K, z flags, w point lights
+  glm::ivec4 lo[kGiMaxLevels];
+};
+static_assert(sizeof(GiParams) == 16 * (16 + 16 + 8 + 8 + 1 + 1 + 16));
+
+struct GiPush {
+  int first = 0;
+  int count = 0;
+  int level = 0;
+  int pad = 0;
+};
+
+enum class GiKernel { kAlpha = 1, kPrecombine = 2, kUpdate = 3, kQuery = 4 };
+
+struct GiLayout {
+  GiParams params{};
+  int n = 0, k = 0;
+  glm::dvec3 origin{0.0};
+  std::vector<float> occ;             // K N^3 * 6
+  std::vector<int32_t> vmap;          // K N^3
+  std::vector<glm::ivec4> surf_pos;   // S: local xyz, level
+  std::vector<glm::vec4> attr;        // S * 18
+  std::vector<int> level_first, level_count;
+  size_t voxels() const { return size_t(k) * size_t(n) * size_t(n) * size_t(n); }
+  size_t surfaces() const { return surf_pos.size(); }
+};
+
+Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& lights, const GiConfig& config);
+
+// The frame logic; backends supply the primitives.
+class GiEngineBase : public GiEngine {
+ public:
+  explicit GiEngineBase(const GiConfig& config) : config_(config) {}
+  Status load(const Cascades& cascades, const GiLights& lights) override;
+  Result<GiTimings> frame() override;
+  Result<GiTimings> update_level(int level) override;
+  Result<GiTimings> update_all(int passes) override;
+  Status irradiance(std::span<const glm::dvec3> points, std::span<const glm::vec3> normals, int bounces,
+                    std::span<glm::vec3> out) override;
+  Result<GiRadiance> radiance() override;
+
+ protected:
+  // Allocates and fills every buffer from the layout; light, pre and alpha zeroed.
+  virtual Status upload(const GiLayout& layout) = 0;
+  // Runs kernel over `count` items from `first` with pc.level = level.
+  virtual Status run(GiKernel kernel, int first, int count, int level) = 0;
+  // Copies light_next to light_prev for surface voxels [first, first + count).
+  virtual Status commit(int first, int count) = 0;
+  virtual Status set_queries(const std::vector<glm::vec4>& qin) = 0;
+  virtual Status get_queries(std::vector<glm::vec4>& qout, size_t count) = 0;
+  virtual Status read_light(std::vector<glm::vec4>& light) = 0;
+
+  Result<GiTimings> update_levels(const std::vector<int>& levels);
+
+  GiConfig config_;
+  GiLayout layout_;
+  bool loaded_ = false;
+  uint64_t frame_ = 0;
+};
+
+}  // namespace ldc::detail

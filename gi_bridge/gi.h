@@ -1,0 +1,156 @@
+// Global illumination from the voxel cascades: cone tracing in 16 fixed
+// directions (the talk's "Lighting" part), on the GPU through Vulkan compute
+// (make_vulkan_gi, target ldc::gi, built with LDC_WITH_VULKAN) and on the CPU
+// (make_cpu_gi, target ldc::gi_cpu, always built), both running the same
+// kernels (shaders/gi_common.glsl is compiled by glslc and included by the
+// CPU code), so they agree to float rounding.
+//
+// Directions. gi_directions(): 16 unit vectors forming a spherical 5-design
+// (every polynomial of degree <= 5 on the sphere integrates exactly as their
+// mean; found by minimising sum_{k=1..5} sum_{i,j} P_k(d_i . d_j), residual
+// 5e-10; the first is +z; smallest angle between two is 50.2 degrees). The
+// same set is used everywhere: cones from voxels, cones from query points,
+// the sky's basis and the precombined buffers.
+//
+// Cones. Each cone covers 4 pi / 16 sr (half-angle acos(7/8) = 29.0 deg).
+// From its apex it is marched at steps of half a voxel of the level whose
+// voxel is the largest not wider than the cone (at least the start level),
+// moving to a coarser level where the position leaves a level's box; at each
+// step the 8-voxel trilinear sample gives an opacity a (the faces looking
+// back at the apex, weighted by d_axis^2; a corner counts only when its
+// voxel lies wholly ahead of the plane through the apex normal to the axis,
+// so a cone never reads the coarse voxel holding its own surface) and light
+// premultiplied by opacity,
+// composited front to back as in volume ray marching (opacity corrected for
+// the half-voxel step: 1 - sqrt(1 - a)). A cone that leaves the coarsest
+// level receives the sky times its transmittance.
+//
+// Light. Per surface voxel and face the cascades hold three radiance buffers
+// (the talk's volumetric light buffers): D = emission + direct light of sky
+// and point lights reflected once, B1 = D gathered and reflected, B2 = B1
+// gathered and reflected. Reflection is Lambertian: for a face with albedo
+// rho and normal n, L_out = rho * sum_i c_i L_i / sum_i c_i with
+// c_i = max(0, n . d_i) (so a uniform radiance L gives irradiance pi L
+// exactly). One update pass traces the 16 cones once and writes all three
+// from the previous frame's buffers (the talk's one-pass scheme): after 3
+// frames of a static scene they equal three separate passes.
+//
+// Sky: 16 spherical radial basis lobes on the directions, normalised to a
+// partition of unity: L_sky(w) = sum_i a_i B_i(w), B_i = exp(k (w . d_i - 1))
+// / sum_j exp(k (w . d_j - 1)). A cone i that escapes gets a_i.
+// Point lights (at most kGiMaxPointLights): radiant intensity I
+// [radiance * m^2]; a cone picks a light up at the step where its march
+// passes the light's distance r, with weight B_i(w_light) I / (Omega r^2) and
+// the transmittance gathered so far (NOT a cascaded volume: see the README of
+// the closing note; a light list instead of an injected volume texture).
+// Emission (MaterialTable) is written into D directly.
+//
+// Outputs: radiance() reads back the per-face light cascades; irradiance()
+// answers batches of points with normals by 16 cones from each point.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "ldc/status.h"
+#include "voxelize/voxelize.h"
+
+namespace ldc {
+
+inline constexpr int kGiDirections = 16;
+inline constexpr int kGiMaxPointLights = 8;
+inline constexpr int kGiMaxLevels = 16;
+
+// The 16 directions (see the header comment).
+const std::array<glm::vec3, kGiDirections>& gi_directions();
+
+struct SkyLight {
+  // Radiance amplitude of each lobe. [Units: radiance] [Limit: >= 0, finite]
+  std::array<glm::vec3, kGiDirections> amplitude{};
+  // Lobe sharpness k. [Limit: 0.5 .. 64] [Default: 6]
+  float sharpness = 6.0f;
+
+  // The same radiance in every direction (exact in this basis).
+  static SkyLight uniform(const glm::vec3& radiance);
+  // Lobes set to the zenith colour above, mixed to the horizon colour at
+  // z = 0 and the ground colour below (by the lobe's direction's z).
+  static SkyLight gradient(const glm::vec3& zenith, const glm::vec3& horizon, const glm::vec3& ground);
+  // L_sky(w) for a unit direction.
+  glm::vec3 radiance(const glm::vec3& w) const;
+};
+
+struct PointLight {
+  glm::dvec3 position{0.0};  // [Units: m] world
+  glm::vec3 intensity{0.0f};  // [Units: radiance * m^2, irradiance I / r^2 facing it] [Limit: >= 0]
+};
+
+struct GiLights {
+  SkyLight sky;
+  std::vector<PointLight> points;  // [Limit: size <= kGiMaxPointLights]
+};
+Status check_gi_lights(const GiLights& lights);
+
+struct GiConfig {
+  // Read the 16-direction precombined light/opacity buffers (one lookup per
+  // trilinear corner) instead of blending three faces at every step.
+  // Same results to float rounding. [Default: on]
+  bool precombined = true;
+  // frame() updates one level per frame on the cascades' schedule (level k
+  // every 2^(k+1) frames) instead of every level. [Default: on]
+  bool staggered = true;
+  // Third bounce boost: B2 * min(1, B2 / B1) * boost added to queries with
+  // 3 bounces. [Limit: 0 .. 1] [Default: 0 (off)]
+  float third_bounce_boost = 0.0f;
+  // Query apex offset along the normal. [Units: voxels of the start level] [Limit: 0 .. 4] [Default: 1]
+  float query_offset = 1.0f;
+};
+Status check_gi_config(const GiConfig& config);
+
+// What a frame or a level update did.
+struct GiTimings {
+  int levels_updated = 0;
+  size_t surface_voxels = 0;
+  double seconds = 0.0;  // wall time (GPU: submit to fence)
+};
+
+// Per-face radiance read back: for each surface voxel (level, global voxel
+// coordinates) its six faces' D, B1, B2.
+struct GiRadiance {
+  std::vector<glm::ivec4> voxels;                 // xyz global voxel, w level
+  std::vector<std::array<glm::vec3, 18>> light;   // [face * 3 + channel]
+};
+
+class GiEngine {
+ public:
+  virtual ~GiEngine() = default;
+  virtual const char* name() const = 0;
+
+  // Takes the cascades' packed G-buffer (Cascades::pack) and surface voxels
+  // of every valid level, and the lights; clears the light buffers.
+  virtual Status load(const Cascades& cascades, const GiLights& lights) = 0;
+  // One frame: the scheduled level when staggered, otherwise every level.
+  virtual Result<GiTimings> frame() = 0;
+  // One lighting pass of one level (from the previous frame's buffers).
+  virtual Result<GiTimings> update_level(int level) = 0;
+  // Every level, `passes` times (3 passes give D, B1 and B2 of a static scene).
+  virtual Result<GiTimings> update_all(int passes = 1) = 0;
+  // Irradiance (rgb) at world points with unit normals, with 1, 2 or 3
+  // bounces (1: sources seen directly and D; 2: + B1; 3: + B2 and the boost).
+  virtual Status irradiance(std::span<const glm::dvec3> points, std::span<const glm::vec3> normals, int bounces,
+                            std::span<glm::vec3> out) = 0;
+  virtual Result<GiRadiance> radiance() = 0;
+};
+
+std::unique_ptr<GiEngine> make_cpu_gi(const GiConfig& config = {});
+
+// Vulkan 1.1 compute (lavapipe or a GPU). Fails with a message naming the
+// reason when no Vulkan device is found. `device_name` receives its name.
+Result<std::unique_ptr<GiEngine>> make_vulkan_gi(const GiConfig& config = {}, std::string* device_name = nullptr);
+
+}  // namespace ldc

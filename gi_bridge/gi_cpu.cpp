@@ -1,0 +1,135 @@
+// The CPU reference: the same kernels as the Vulkan shaders
+// (shaders/gi_common.glsl, included here), run over the items in parallel.
+#include <cmath>
+
+#include <tbb/parallel_for.h>
+
+#include "gi_bridge/detail/gi_engine.h"
+
+namespace ldc::detail {
+namespace {
+
+using glm::ivec3;
+using glm::ivec4;
+using glm::vec3;
+using glm::vec4;
+using glm::abs;
+using glm::clamp;
+using glm::dot;
+using glm::exp;
+using glm::floor;
+using glm::length;
+using glm::max;
+using glm::min;
+using glm::sqrt;
+
+struct Buffers {
+  std::vector<float> occ, alpha;
+  std::vector<int32_t> vmap;
+  std::vector<ivec4> surf_pos;
+  std::vector<vec4> attr, light_prev, light_next, pre, qin, qout;
+};
+
+#define GI_CONST static constexpr
+#define OUT(T) T&
+#define INOUT(T) T&
+#define XYZ(v) vec3(v)
+#define IXYZ(v) ivec3(v)
+
+// One kernel invocation context: the uniform block, the push constants and
+// the buffers, reached through the accessors gi_common.glsl expects.
+struct Kernels {
+  GiParams P;
+  GiPush pc;
+  Buffers* b;
+
+  float occ_load(int i) const { return b->occ[size_t(i)]; }
+  float alpha_load(int i) const { return b->alpha[size_t(i)]; }
+  void alpha_store(int i, float a) const { b->alpha[size_t(i)] = a; }
+  int vmap_load(int i) const { return b->vmap[size_t(i)]; }
+  ivec4 surf_pos_load(int i) const { return b->surf_pos[size_t(i)]; }
+  vec4 attr_load(int i) const { return b->attr[size_t(i)]; }
+  vec4 light_load(int i) const { return b->light_prev[size_t(i)]; }
+  void light_store(int i, vec4 v) const { b->light_next[size_t(i)] = v; }
+  vec4 pre_load(int i) const { return b->pre[size_t(i)]; }
+  void pre_store(int i, vec4 v) const { b->pre[size_t(i)] = v; }
+  vec4 qin_load(int i) const { return b->qin[size_t(i)]; }
+  void qout_store(int i, vec4 v) const { b->qout[size_t(i)] = v; }
+
+#include "gi_bridge/shaders/gi_common.glsl"
+};
+
+#undef GI_CONST
+#undef OUT
+#undef INOUT
+#undef XYZ
+#undef IXYZ
+
+class CpuGi final : public GiEngineBase {
+ public:
+  explicit CpuGi(const GiConfig& config) : GiEngineBase(config) {}
+  const char* name() const override { return "cpu"; }
+
+ protected:
+  Status upload(const GiLayout& layout) override {
+    params_ = layout.params;
+    b_.occ = layout.occ;
+    b_.vmap = layout.vmap;
+    b_.surf_pos = layout.surf_pos;
+    b_.attr = layout.attr;
+    b_.alpha.assign(layout.voxels() * 16, 0.0f);
+    b_.light_prev.assign(layout.surfaces() * 18, vec4(0.0f));
+    b_.light_next = b_.light_prev;
+    b_.pre.assign(layout.surfaces() * 48, vec4(0.0f));
+    return {};
+  }
+
+  Status run(GiKernel kernel, int first, int count, int level) override {
+    Kernels k{params_, GiPush{first, kernel == GiKernel::kPrecombine ? count / 16 : count, level, 0}, &b_};
+    const int items = count;
+    tbb::parallel_for(tbb::blocked_range<int>(0, items, 64), [&](const tbb::blocked_range<int>& r) {
+      for (int gid = r.begin(); gid < r.end(); ++gid) {
+        switch (kernel) {
+          case GiKernel::kAlpha: k.kernel_alpha(first + gid); break;
+          case GiKernel::kPrecombine: k.kernel_precombine(gid); break;
+          case GiKernel::kUpdate: k.kernel_update(gid); break;
+          case GiKernel::kQuery: k.kernel_query(gid); break;
+        }
+      }
+    });
+    return {};
+  }
+
+  Status commit(int first, int count) override {
+    std::copy(b_.light_next.begin() + ptrdiff_t(first) * 18, b_.light_next.begin() + ptrdiff_t(first + count) * 18,
+              b_.light_prev.begin() + ptrdiff_t(first) * 18);
+    return {};
+  }
+
+  Status set_queries(const std::vector<vec4>& qin) override {
+    b_.qin = qin;
+    b_.qout.assign(qin.size() / 2, vec4(0.0f));
+    return {};
+  }
+  Status get_queries(std::vector<vec4>& qout, size_t count) override {
+    qout.assign(b_.qout.begin(), b_.qout.begin() + ptrdiff_t(count));
+    return {};
+  }
+  Status read_light(std::vector<vec4>& light) override {
+    light = b_.light_prev;
+    return {};
+  }
+
+ private:
+  GiParams params_{};
+  Buffers b_;
+};
+
+}  // namespace
+}  // namespace ldc::detail
+
+namespace ldc {
+std::unique_ptr<GiEngine> make_cpu_gi(const GiConfig& config) {
+  return std::make_unique<detail::CpuGi>(config);
+}
+}  // namespace ldc

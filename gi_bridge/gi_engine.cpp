@@ -1,0 +1,274 @@
+// Directions, sky, checks, the flat layout and the frame logic shared by the
+// CPU and Vulkan engines.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <sstream>
+
+#include "gi_bridge/detail/gi_engine.h"
+
+namespace ldc {
+
+const std::array<glm::vec3, kGiDirections>& gi_directions() {
+  // A spherical 5-design of 16 points (see gi.h), rotated so that the first is +z.
+  static const std::array<glm::vec3, kGiDirections> dirs = {{
+      {0.000000000f, 0.000000000f, 1.000000000f},   {0.111322681f, -0.759955073f, 0.640371414f},
+      {-0.602368130f, 0.689405709f, 0.402333699f},  {-0.609689154f, 0.655894209f, -0.445063954f},
+      {0.892643446f, 0.408121935f, -0.191374412f},  {0.676167203f, -0.236961508f, -0.697601001f},
+      {0.765071787f, -0.633572552f, 0.115112908f},  {0.091852540f, 0.347298752f, -0.933245245f},
+      {0.220492089f, 0.778874054f, 0.587144315f},   {0.233512282f, 0.937721798f, -0.257196119f},
+      {-0.401600270f, -0.337574962f, -0.851328590f}, {-0.768022854f, -0.110343176f, 0.630844893f},
+      {-0.960572127f, -0.105614392f, -0.257190181f}, {-0.551208054f, -0.826388575f, 0.115115614f},
+      {0.805185298f, 0.083286831f, 0.587145586f},   {0.097201628f, -0.890207774f, -0.445063998f},
+  }};
+  return dirs;
+}
+
+SkyLight SkyLight::uniform(const glm::vec3& radiance) {
+  SkyLight s;
+  s.amplitude.fill(radiance);
+  return s;
+}
+
+SkyLight SkyLight::gradient(const glm::vec3& zenith, const glm::vec3& horizon, const glm::vec3& ground) {
+  SkyLight s;
+  for (int i = 0; i < kGiDirections; ++i) {
+    const float z = gi_directions()[size_t(i)].z;
+    s.amplitude[size_t(i)] = z >= 0.0f ? glm::mix(horizon, zenith, z) : glm::mix(horizon, ground, -z);
+  }
+  return s;
+}
+
+glm::vec3 SkyLight::radiance(const glm::vec3& w) const {
+  glm::vec3 sum(0.0f);
+  float norm = 0.0f;
+  for (int i = 0; i < kGiDirections; ++i) {
+    const float g = std::exp(sharpness * (glm::dot(w, gi_directions()[size_t(i)]) - 1.0f));
+    sum += g * amplitude[size_t(i)];
+    norm += g;
+  }
+  return sum / norm;
+}
+
+namespace {
+bool finite_nonneg(const glm::vec3& v) {
+  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && v.x >= 0.0f && v.y >= 0.0f &&
+         v.z >= 0.0f;
+}
+Status bad(const std::string& what) { return Status(ErrorCode::kInvalidArgument, what); }
+}  // namespace
+
+Status check_gi_lights(const GiLights& lights) {
+  for (int i = 0; i < kGiDirections; ++i) {
+    if (!finite_nonneg(lights.sky.amplitude[size_t(i)]))
+      return bad("sky amplitude " + std::to_string(i) + " must be finite and >= 0");
+  }
+  if (!(lights.sky.sharpness >= 0.5f && lights.sky.sharpness <= 64.0f)) {
+    std::ostringstream s;
+    s << "sky sharpness " << lights.sky.sharpness << " must be in 0.5 .. 64";
+    return bad(s.str());
+  }
+  if (lights.points.size() > size_t(kGiMaxPointLights))
+    return bad(std::to_string(lights.points.size()) + " point lights: at most " +
+               std::to_string(kGiMaxPointLights));
+  for (size_t i = 0; i < lights.points.size(); ++i) {
+    const PointLight& p = lights.points[i];
+    if (!finite_nonneg(p.intensity) || !std::isfinite(p.position.x) || !std::isfinite(p.position.y) ||
+        !std::isfinite(p.position.z))
+      return bad("point light " + std::to_string(i) + ": position must be finite and intensity finite and >= 0");
+  }
+  return {};
+}
+
+Status check_gi_config(const GiConfig& config) {
+  if (!(config.third_bounce_boost >= 0.0f && config.third_bounce_boost <= 1.0f)) {
+    std::ostringstream s;
+    s << "third_bounce_boost " << config.third_bounce_boost << " must be in 0 .. 1";
+    return bad(s.str());
+  }
+  if (!(config.query_offset >= 0.0f && config.query_offset <= 4.0f)) {
+    std::ostringstream s;
+    s << "query_offset " << config.query_offset << " must be in 0 .. 4";
+    return bad(s.str());
+  }
+  return {};
+}
+
+namespace detail {
+
+namespace {
+
+void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfig& config, GiLayout& out) {
+  GiParams& p = out.params;
+  for (int i = 0; i < kGiDirections; ++i) {
+    p.dirs[i] = glm::vec4(gi_directions()[size_t(i)], 0.0f);
+    p.sky[i] = glm::vec4(lights.sky.amplitude[size_t(i)], 0.0f);
+  }
+  for (size_t i = 0; i < lights.points.size(); ++i) {
+    p.light_pos[i] = glm::vec4(glm::vec3(lights.points[i].position - out.origin), 1.0f);
+    p.light_int[i] = glm::vec4(lights.points[i].intensity, 0.0f);
+  }
+  p.fparams = glm::vec4(float(cascades.voxel_size(0)), config.third_bounce_boost, config.query_offset,
+                        lights.sky.sharpness);
+  p.iparams = glm::ivec4(out.n, out.k, config.precombined ? 1 : 0, int(lights.points.size()));
+  for (int l = 0; l < out.k; ++l) p.lo[l] = glm::ivec4(cascades.level_box(l).lo, 0);
+}
+
+// Surface voxels of one level: those with a face holding its own surface.
+void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
+  const int n = out.n;
+  out.level_first[size_t(l)] = int(out.surf_pos.size());
+  for (int z = 0; z < n; ++z) {
+    for (int y = 0; y < n; ++y) {
+      for (int x = 0; x < n; ++x) {
+        const glm::ivec3 c(x, y, z);
+        const size_t voxel = size_t(l) * size_t(n) * n * n + (size_t(z) * n + size_t(y)) * n + size_t(x);
+        out.vmap[voxel] = -1;
+        if (!valid) continue;
+        FaceSample f[kFaces];
+        bool surface = false;
+        for (int i = 0; i < kFaces; ++i) {
+          f[i] = packed.sample(i, l, c);
+          out.occ[voxel * 6 + size_t(i)] = f[i].occupancy;
+          surface = surface || ((f[i].flags & kFaceOwn) && f[i].albedo.a > 0.0f);
+        }
+        if (!surface) continue;
+        out.vmap[voxel] = int32_t(out.surf_pos.size());
+        out.surf_pos.emplace_back(c, l);
+        for (int i = 0; i < kFaces; ++i) {
+          const bool own = (f[i].flags & kFaceOwn) && f[i].albedo.a > 0.0f;
+          out.attr.emplace_back(glm::vec3(f[i].albedo), own ? f[i].albedo.a : 0.0f);
+          out.attr.emplace_back(f[i].normal, 0.0f);
+          out.attr.emplace_back(f[i].emission, 0.0f);
+        }
+      }
+    }
+  }
+  out.level_count[size_t(l)] = int(out.surf_pos.size()) - out.level_first[size_t(l)];
+}
+
+}  // namespace
+
+Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& lights, const GiConfig& config) {
+  if (Status s = check_gi_config(config); !s.ok()) return s;
+  if (Status s = check_gi_lights(lights); !s.ok()) return s;
+  GiLayout out;
+  out.n = cascades.resolution();
+  out.k = cascades.levels();
+  if (out.k > kGiMaxLevels) return bad("cascades of " + std::to_string(out.k) + " levels: at most 16");
+  out.origin = cascades.origin();
+  fill_params(cascades, lights, config, out);
+  PackedGBuffer packed;
+  cascades.pack(&packed);
+  out.occ.assign(out.voxels() * 6, 0.0f);
+  out.vmap.assign(out.voxels(), -1);
+  out.level_first.assign(size_t(out.k), 0);
+  out.level_count.assign(size_t(out.k), 0);
+  for (int l = 0; l < out.k; ++l) add_level(packed, l, cascades.level_valid(l), out);
+  return out;
+}
+
+Status GiEngineBase::load(const Cascades& cascades, const GiLights& lights) {
+  Result<GiLayout> layout = build_gi_layout(cascades, lights, config_);
+  if (!layout.ok()) return layout.status();
+  layout_ = std::move(layout).value();
+  loaded_ = false;
+  if (Status s = upload(layout_); !s.ok()) return s;
+  const int alpha_items = int(layout_.voxels() * 16);
+  if (Status s = run(GiKernel::kAlpha, 0, alpha_items, 0); !s.ok()) return s;
+  loaded_ = true;
+  frame_ = 0;
+  return {};
+}
+
+Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
+  if (!loaded_) return Status(ErrorCode::kInvalidArgument, "gi: load() the cascades first");
+  const auto t0 = std::chrono::steady_clock::now();
+  GiTimings t;
+  for (int l : levels) {
+    if (l < 0 || l >= layout_.k) return bad("gi: level " + std::to_string(l) + " is not in 0 .. " +
+                                            std::to_string(layout_.k - 1));
+  }
+  // All reads come from the previous frame's buffers: update every level
+  // first, then commit and precombine.
+  for (int l : levels) {
+    const int c = layout_.level_count[size_t(l)];
+    if (c == 0) continue;
+    if (Status s = run(GiKernel::kUpdate, layout_.level_first[size_t(l)], c, l); !s.ok()) return s;
+    t.surface_voxels += size_t(c);
+  }
+  for (int l : levels) {
+    const int first = layout_.level_first[size_t(l)], c = layout_.level_count[size_t(l)];
+    if (c == 0) continue;
+    if (Status s = commit(first, c); !s.ok()) return s;
+    if (config_.precombined) {
+      if (Status s = run(GiKernel::kPrecombine, first, c * 16, l); !s.ok()) return s;
+    }
+  }
+  t.levels_updated = int(levels.size());
+  t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return t;
+}
+
+Result<GiTimings> GiEngineBase::update_level(int level) { return update_levels({level}); }
+
+Result<GiTimings> GiEngineBase::update_all(int passes) {
+  std::vector<int> all;
+  for (int l = 0; l < layout_.k; ++l) all.push_back(l);
+  GiTimings sum;
+  for (int p = 0; p < passes; ++p) {
+    Result<GiTimings> t = update_levels(all);
+    if (!t.ok()) return t;
+    sum.levels_updated += t.value().levels_updated;
+    sum.surface_voxels += t.value().surface_voxels;
+    sum.seconds += t.value().seconds;
+  }
+  return sum;
+}
+
+Result<GiTimings> GiEngineBase::frame() {
+  if (!config_.staggered) return update_all(1);
+  const int level = Cascades::scheduled_level(frame_++, layout_.k);
+  return update_level(level);
+}
+
+Status GiEngineBase::irradiance(std::span<const glm::dvec3> points, std::span<const glm::vec3> normals,
+                                int bounces, std::span<glm::vec3> out) {
+  if (!loaded_) return Status(ErrorCode::kInvalidArgument, "gi: load() the cascades first");
+  if (normals.size() != points.size() || out.size() != points.size())
+    return bad("gi irradiance: " + std::to_string(points.size()) + " points, " + std::to_string(normals.size()) +
+               " normals and " + std::to_string(out.size()) + " outputs: the sizes must match");
+  if (bounces < 1 || bounces > 3) return bad("gi irradiance: bounces " + std::to_string(bounces) + " must be 1 .. 3");
+  if (points.empty()) return {};
+  std::vector<glm::vec4> qin(points.size() * 2);
+  for (size_t i = 0; i < points.size(); ++i) {
+    qin[2 * i] = glm::vec4(glm::vec3(points[i] - layout_.origin), 1.0f);
+    const float len = glm::length(normals[i]);
+    if (!(len > 0.0f) || !std::isfinite(len)) return bad("gi irradiance: normal " + std::to_string(i) + " has no length");
+    qin[2 * i + 1] = glm::vec4(normals[i] / len, 0.0f);
+  }
+  if (Status s = set_queries(qin); !s.ok()) return s;
+  if (Status s = run(GiKernel::kQuery, 0, int(points.size()), bounces); !s.ok()) return s;
+  std::vector<glm::vec4> qout;
+  if (Status s = get_queries(qout, points.size()); !s.ok()) return s;
+  for (size_t i = 0; i < points.size(); ++i) out[i] = glm::vec3(qout[i]);
+  return {};
+}
+
+Result<GiRadiance> GiEngineBase::radiance() {
+  if (!loaded_) return Status(ErrorCode::kInvalidArgument, "gi: load() the cascades first");
+  std::vector<glm::vec4> light;
+  if (Status s = read_light(light); !s.ok()) return s;
+  GiRadiance r;
+  r.voxels.resize(layout_.surfaces());
+  r.light.resize(layout_.surfaces());
+  for (size_t s = 0; s < layout_.surfaces(); ++s) {
+    const glm::ivec4 p = layout_.surf_pos[s];
+    r.voxels[s] = glm::ivec4(glm::ivec3(p) + glm::ivec3(layout_.params.lo[p.w]), p.w);
+    for (int j = 0; j < 18; ++j) r.light[s][size_t(j)] = glm::vec3(light[s * 18 + size_t(j)]);
+  }
+  return r;
+}
+
+}  // namespace detail
+}  // namespace ldc

@@ -1,0 +1,386 @@
+// The Vulkan engine: Vulkan 1.1 core compute only (runs on Mesa's lavapipe),
+// the kernels of shaders/gi.comp compiled by glslc at build time and
+// embedded. Every buffer is host-visible and coherent (on lavapipe all
+// memory is); each primitive is one submit waited on with a fence.
+#include <cstring>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "gi_bridge/detail/gi_engine.h"
+
+namespace ldc::detail {
+namespace {
+
+const uint32_t kSpvAlpha[] =
+#include "gi_kernel1.spv.inc"
+    ;
+const uint32_t kSpvPrecombine[] =
+#include "gi_kernel2.spv.inc"
+    ;
+const uint32_t kSpvUpdate[] =
+#include "gi_kernel3.spv.inc"
+    ;
+const uint32_t kSpvQuery[] =
+#include "gi_kernel4.spv.inc"
+    ;
+
+constexpr int kBindings = 11;
+constexpr int kGroup = 64;         // local_size_x
+constexpr int kMaxGroups = 65535;  // per dispatch (the guaranteed minimum)
+
+Status vk_error(const char* what, VkResult r) {
+  return Status(ErrorCode::kIoError, std::string("vulkan: ") + what + " failed (VkResult " + std::to_string(int(r)) + ")");
+}
+
+struct Buffer {
+  VkBuffer buffer = VK_NULL_HANDLE;
+  VkDeviceMemory memory = VK_NULL_HANDLE;
+  void* mapped = nullptr;
+  VkDeviceSize size = 0;
+};
+
+class VulkanGi final : public GiEngineBase {
+ public:
+  explicit VulkanGi(const GiConfig& config) : GiEngineBase(config) {}
+  ~VulkanGi() override { destroy(); }
+  const char* name() const override { return "vulkan"; }
+
+  Status init(std::string* device_name);
+
+ protected:
+  Status upload(const GiLayout& layout) override;
+  Status run(GiKernel kernel, int first, int count, int level) override;
+  Status commit(int first, int count) override;
+  Status set_queries(const std::vector<glm::vec4>& qin) override;
+  Status get_queries(std::vector<glm::vec4>& qout, size_t count) override;
+  Status read_light(std::vector<glm::vec4>& light) override;
+
+ private:
+  Status make_buffer(int binding, VkDeviceSize size, const void* data);
+  void free_buffer(Buffer& b);
+  void write_descriptors();
+  Status make_pipelines();
+  void destroy();
+
+  VkInstance instance_ = VK_NULL_HANDLE;
+  VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+  VkDevice device_ = VK_NULL_HANDLE;
+  VkQueue queue_ = VK_NULL_HANDLE;
+  uint32_t queue_family_ = 0;
+  VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
+  VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
+  VkPipeline pipelines_[4] = {VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE};
+  VkDescriptorPool pool_ = VK_NULL_HANDLE;
+  VkDescriptorSet set_ = VK_NULL_HANDLE;
+  VkCommandPool command_pool_ = VK_NULL_HANDLE;
+  VkCommandBuffer cmd_ = VK_NULL_HANDLE;
+  VkFence fence_ = VK_NULL_HANDLE;
+  Buffer buffers_[kBindings];
+};
+
+// Prefers a discrete GPU, then an integrated one, then anything (lavapipe).
+int device_rank(VkPhysicalDeviceType t) {
+  switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    default: return 3;
+  }
+}
+
+Status VulkanGi::init(std::string* device_name) {
+  VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+  app.pApplicationName = "ldc gi";
+  app.apiVersion = VK_API_VERSION_1_1;
+  VkInstanceCreateInfo ici{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+  ici.pApplicationInfo = &app;
+  if (VkResult r = vkCreateInstance(&ici, nullptr, &instance_); r != VK_SUCCESS)
+    return Status(ErrorCode::kIoError, "vulkan: no Vulkan instance (VkResult " + std::to_string(int(r)) +
+                                           "): is a Vulkan driver (e.g. mesa-vulkan-drivers) installed?");
+  uint32_t count = 0;
+  vkEnumeratePhysicalDevices(instance_, &count, nullptr);
+  std::vector<VkPhysicalDevice> devices(count);
+  vkEnumeratePhysicalDevices(instance_, &count, devices.data());
+  int best_rank = 99;
+  for (VkPhysicalDevice d : devices) {
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(d, &props);
+    if (props.apiVersion < VK_API_VERSION_1_1) continue;
+    uint32_t nq = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &nq, nullptr);
+    std::vector<VkQueueFamilyProperties> qs(nq);
+    vkGetPhysicalDeviceQueueFamilyProperties(d, &nq, qs.data());
+    for (uint32_t q = 0; q < nq; ++q) {
+      if ((qs[q].queueFlags & VK_QUEUE_COMPUTE_BIT) && device_rank(props.deviceType) < best_rank) {
+        best_rank = device_rank(props.deviceType);
+        physical_ = d;
+        queue_family_ = q;
+        if (device_name) *device_name = props.deviceName;
+        break;
+      }
+    }
+  }
+  if (physical_ == VK_NULL_HANDLE) return Status(ErrorCode::kIoError, "vulkan: no Vulkan 1.1 device with a compute queue");
+  const float priority = 1.0f;
+  VkDeviceQueueCreateInfo qci{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+  qci.queueFamilyIndex = queue_family_;
+  qci.queueCount = 1;
+  qci.pQueuePriorities = &priority;
+  VkDeviceCreateInfo dci{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+  dci.queueCreateInfoCount = 1;
+  dci.pQueueCreateInfos = &qci;
+  if (VkResult r = vkCreateDevice(physical_, &dci, nullptr, &device_); r != VK_SUCCESS) return vk_error("vkCreateDevice", r);
+  vkGetDeviceQueue(device_, queue_family_, 0, &queue_);
+  VkCommandPoolCreateInfo pci{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+  pci.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+  pci.queueFamilyIndex = queue_family_;
+  if (VkResult r = vkCreateCommandPool(device_, &pci, nullptr, &command_pool_); r != VK_SUCCESS)
+    return vk_error("vkCreateCommandPool", r);
+  VkCommandBufferAllocateInfo cai{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+  cai.commandPool = command_pool_;
+  cai.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+  cai.commandBufferCount = 1;
+  if (VkResult r = vkAllocateCommandBuffers(device_, &cai, &cmd_); r != VK_SUCCESS)
+    return vk_error("vkAllocateCommandBuffers", r);
+  VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+  if (VkResult r = vkCreateFence(device_, &fci, nullptr, &fence_); r != VK_SUCCESS) return vk_error("vkCreateFence", r);
+  return make_pipelines();
+}
+
+Status VulkanGi::make_pipelines() {
+  VkDescriptorSetLayoutBinding b[kBindings];
+  for (int i = 0; i < kBindings; ++i) {
+    b[i] = {};
+    b[i].binding = uint32_t(i);
+    b[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    b[i].descriptorCount = 1;
+    b[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+  }
+  VkDescriptorSetLayoutCreateInfo lci{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+  lci.bindingCount = kBindings;
+  lci.pBindings = b;
+  if (VkResult r = vkCreateDescriptorSetLayout(device_, &lci, nullptr, &set_layout_); r != VK_SUCCESS)
+    return vk_error("vkCreateDescriptorSetLayout", r);
+  VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(GiPush)};
+  VkPipelineLayoutCreateInfo plci{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+  plci.setLayoutCount = 1;
+  plci.pSetLayouts = &set_layout_;
+  plci.pushConstantRangeCount = 1;
+  plci.pPushConstantRanges = &push;
+  if (VkResult r = vkCreatePipelineLayout(device_, &plci, nullptr, &pipeline_layout_); r != VK_SUCCESS)
+    return vk_error("vkCreatePipelineLayout", r);
+  const std::pair<const uint32_t*, size_t> code[4] = {{kSpvAlpha, sizeof(kSpvAlpha)},
+                                                      {kSpvPrecombine, sizeof(kSpvPrecombine)},
+                                                      {kSpvUpdate, sizeof(kSpvUpdate)},
+                                                      {kSpvQuery, sizeof(kSpvQuery)}};
+  for (int i = 0; i < 4; ++i) {
+    VkShaderModuleCreateInfo smci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    smci.codeSize = code[i].second;
+    smci.pCode = code[i].first;
+    VkShaderModule module;
+    if (VkResult r = vkCreateShaderModule(device_, &smci, nullptr, &module); r != VK_SUCCESS)
+      return vk_error("vkCreateShaderModule", r);
+    VkComputePipelineCreateInfo cpci{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    cpci.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    cpci.stage.module = module;
+    cpci.stage.pName = "main";
+    cpci.layout = pipeline_layout_;
+    VkResult r = vkCreateComputePipelines(device_, VK_NULL_HANDLE, 1, &cpci, nullptr, &pipelines_[i]);
+    vkDestroyShaderModule(device_, module, nullptr);
+    if (r != VK_SUCCESS) return vk_error("vkCreateComputePipelines", r);
+  }
+  VkDescriptorPoolSize sizes[2] = {{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+                                   {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, kBindings - 1}};
+  VkDescriptorPoolCreateInfo dpci{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+  dpci.maxSets = 1;
+  dpci.poolSizeCount = 2;
+  dpci.pPoolSizes = sizes;
+  if (VkResult r = vkCreateDescriptorPool(device_, &dpci, nullptr, &pool_); r != VK_SUCCESS)
+    return vk_error("vkCreateDescriptorPool", r);
+  VkDescriptorSetAllocateInfo dsai{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+  dsai.descriptorPool = pool_;
+  dsai.descriptorSetCount = 1;
+  dsai.pSetLayouts = &set_layout_;
+  if (VkResult r = vkAllocateDescriptorSets(device_, &dsai, &set_); r != VK_SUCCESS)
+    return vk_error("vkAllocateDescriptorSets", r);
+  return {};
+}
+
+void VulkanGi::free_buffer(Buffer& b) {
+  if (b.buffer) vkDestroyBuffer(device_, b.buffer, nullptr);
+  if (b.memory) vkFreeMemory(device_, b.memory, nullptr);
+  b = Buffer{};
+}
+
+Status VulkanGi::make_buffer(int binding, VkDeviceSize size, const void* data) {
+  Buffer& b = buffers_[binding];
+  free_buffer(b);
+  size = std::max<VkDeviceSize>(size, 16);
+  VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+  bci.size = size;
+  bci.usage = binding == 0 ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+  if (VkResult r = vkCreateBuffer(device_, &bci, nullptr, &b.buffer); r != VK_SUCCESS) return vk_error("vkCreateBuffer", r);
+  VkMemoryRequirements req;
+  vkGetBufferMemoryRequirements(device_, b.buffer, &req);
+  VkPhysicalDeviceMemoryProperties mp;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
+  const VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
+  uint32_t type = UINT32_MAX;
+  for (uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i) {
+    if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want) type = i;
+  }
+  if (type == UINT32_MAX) return Status(ErrorCode::kIoError, "vulkan: no host-visible coherent memory type");
+  VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+  mai.allocationSize = req.size;
+  mai.memoryTypeIndex = type;
+  if (VkResult r = vkAllocateMemory(device_, &mai, nullptr, &b.memory); r != VK_SUCCESS)
+    return vk_error("vkAllocateMemory", r);
+  vkBindBufferMemory(device_, b.buffer, b.memory, 0);
+  if (VkResult r = vkMapMemory(device_, b.memory, 0, size, 0, &b.mapped); r != VK_SUCCESS) return vk_error("vkMapMemory", r);
+  b.size = size;
+  if (data) std::memcpy(b.mapped, data, size_t(size));
+  else std::memset(b.mapped, 0, size_t(size));
+  return {};
+}
+
+void VulkanGi::write_descriptors() {
+  VkDescriptorBufferInfo info[kBindings];
+  VkWriteDescriptorSet w[kBindings];
+  for (int i = 0; i < kBindings; ++i) {
+    info[i] = {buffers_[i].buffer, 0, VK_WHOLE_SIZE};
+    w[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+    w[i].dstSet = set_;
+    w[i].dstBinding = uint32_t(i);
+    w[i].descriptorCount = 1;
+    w[i].descriptorType = i == 0 ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    w[i].pBufferInfo = &info[i];
+  }
+  vkUpdateDescriptorSets(device_, kBindings, w, 0, nullptr);
+}
+
+template <class T>
+VkDeviceSize bytes(const std::vector<T>& v) {
+  return VkDeviceSize(v.size() * sizeof(T));
+}
+
+Status VulkanGi::upload(const GiLayout& layout) {
+  vkDeviceWaitIdle(device_);
+  const size_t s = layout.surfaces();
+  Status st = make_buffer(0, sizeof(GiParams), &layout.params);
+  if (st.ok()) st = make_buffer(1, bytes(layout.occ), layout.occ.data());
+  if (st.ok()) st = make_buffer(2, layout.voxels() * 16 * sizeof(float), nullptr);
+  if (st.ok()) st = make_buffer(3, bytes(layout.vmap), layout.vmap.data());
+  if (st.ok()) st = make_buffer(4, bytes(layout.surf_pos), layout.surf_pos.data());
+  if (st.ok()) st = make_buffer(5, bytes(layout.attr), layout.attr.data());
+  if (st.ok()) st = make_buffer(6, s * 18 * sizeof(glm::vec4), nullptr);
+  if (st.ok()) st = make_buffer(7, s * 18 * sizeof(glm::vec4), nullptr);
+  if (st.ok()) st = make_buffer(8, s * 48 * sizeof(glm::vec4), nullptr);
+  if (st.ok() && !buffers_[9].buffer) st = make_buffer(9, 32, nullptr);
+  if (st.ok() && !buffers_[10].buffer) st = make_buffer(10, 16, nullptr);
+  if (!st.ok()) return st;
+  write_descriptors();
+  return {};
+}
+
+Status VulkanGi::run(GiKernel kernel, int first, int count, int level) {
+  if (count <= 0) return {};
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  vkBeginCommandBuffer(cmd_, &begin);
+  vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[int(kernel) - 1]);
+  vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
+  // Only the alpha kernel takes its offset from pc.first per item; the others
+  // are dispatched whole (their counts stay far below the dispatch limit).
+  const int per_dispatch = kGroup * kMaxGroups;
+  if (kernel == GiKernel::kAlpha) {
+    for (int done = 0; done < count; done += per_dispatch) {
+      GiPush push{first + done, std::min(per_dispatch, count - done), level, 0};
+      vkCmdPushConstants(cmd_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+      vkCmdDispatch(cmd_, uint32_t((push.count + kGroup - 1) / kGroup), 1, 1);
+    }
+  } else {
+    if (count > per_dispatch) {
+      vkEndCommandBuffer(cmd_);
+      return Status(ErrorCode::kInvalidArgument, "vulkan: " + std::to_string(count) + " items in one dispatch (at most " +
+                                                     std::to_string(per_dispatch) + ")");
+    }
+    const int items = kernel == GiKernel::kPrecombine ? count / 16 : count;
+    GiPush push{first, items, level, 0};
+    vkCmdPushConstants(cmd_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
+    vkCmdDispatch(cmd_, uint32_t((count + kGroup - 1) / kGroup), 1, 1);
+  }
+  vkEndCommandBuffer(cmd_);
+  VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+  submit.commandBufferCount = 1;
+  submit.pCommandBuffers = &cmd_;
+  if (VkResult r = vkQueueSubmit(queue_, 1, &submit, fence_); r != VK_SUCCESS) return vk_error("vkQueueSubmit", r);
+  if (VkResult r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX); r != VK_SUCCESS)
+    return vk_error("vkWaitForFences", r);
+  vkResetFences(device_, 1, &fence_);
+  vkResetCommandBuffer(cmd_, 0);
+  return {};
+}
+
+Status VulkanGi::commit(int first, int count) {
+  const size_t off = size_t(first) * 18 * sizeof(glm::vec4), n = size_t(count) * 18 * sizeof(glm::vec4);
+  std::memcpy(static_cast<char*>(buffers_[6].mapped) + off, static_cast<const char*>(buffers_[7].mapped) + off, n);
+  return {};
+}
+
+Status VulkanGi::set_queries(const std::vector<glm::vec4>& qin) {
+  const VkDeviceSize in = std::max<VkDeviceSize>(bytes(qin), 32), out = in / 2;
+  if (buffers_[9].size < in || buffers_[10].size < out) {
+    vkDeviceWaitIdle(device_);
+    if (Status s = make_buffer(9, in, nullptr); !s.ok()) return s;
+    if (Status s = make_buffer(10, out, nullptr); !s.ok()) return s;
+    write_descriptors();
+  }
+  std::memcpy(buffers_[9].mapped, qin.data(), size_t(bytes(qin)));
+  return {};
+}
+
+Status VulkanGi::get_queries(std::vector<glm::vec4>& qout, size_t count) {
+  qout.resize(count);
+  std::memcpy(qout.data(), buffers_[10].mapped, count * sizeof(glm::vec4));
+  return {};
+}
+
+Status VulkanGi::read_light(std::vector<glm::vec4>& light) {
+  light.resize(layout_.surfaces() * 18);
+  std::memcpy(light.data(), buffers_[6].mapped, light.size() * sizeof(glm::vec4));
+  return {};
+}
+
+void VulkanGi::destroy() {
+  if (device_) {
+    vkDeviceWaitIdle(device_);
+    for (Buffer& b : buffers_) free_buffer(b);
+    for (VkPipeline p : pipelines_) {
+      if (p) vkDestroyPipeline(device_, p, nullptr);
+    }
+    if (pool_) vkDestroyDescriptorPool(device_, pool_, nullptr);
+    if (pipeline_layout_) vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
+    if (set_layout_) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
+    if (fence_) vkDestroyFence(device_, fence_, nullptr);
+    if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
+    vkDestroyDevice(device_, nullptr);
+  }
+  if (instance_) vkDestroyInstance(instance_, nullptr);
+  device_ = VK_NULL_HANDLE;
+  instance_ = VK_NULL_HANDLE;
+}
+
+}  // namespace
+}  // namespace ldc::detail
+
+namespace ldc {
+Result<std::unique_ptr<GiEngine>> make_vulkan_gi(const GiConfig& config, std::string* device_name) {
+  if (Status s = check_gi_config(config); !s.ok()) return s;
+  auto engine = std::make_unique<detail::VulkanGi>(config);
+  if (Status s = engine->init(device_name); !s.ok()) return s;
+  return std::unique_ptr<GiEngine>(std::move(engine));
+}
+}  // namespace ldc

@@ -1,0 +1,322 @@
+// The cone tracing kernels, in the subset of GLSL 4.50 that is also C++20
+// with GLM: compiled by glslc into the Vulkan shaders (shaders/gi.comp) and
+// included by the CPU reference (gi_cpu.cpp) inside a struct, so that both
+// run the same algorithm step for step. Conventions that keep it both:
+// float literals carry an f suffix, conversions are written T(x), out and
+// inout parameters go through OUT(T) / INOUT(T), and the data is reached
+// through accessor functions each side defines (occ_load, light_load, ...),
+// plus the uniform block P and the push constants pc.
+//
+// Layouts (indices into flat arrays; N voxels per axis, K levels, S surface
+// voxels, sorted by level):
+//   voxel v of level l (local coords c):  l * N^3 + (c.z * N + c.y) * N + c.x
+//   occ:    (voxel * 6 + face)            face opacity
+//   alpha:  (voxel * 16 + dir)            premultiplied opacity seen along dir
+//   vmap:   voxel -> surface index or -1
+//   attr:   (s * 6 + face) * 3 + {0 albedo rgb+weight, 1 normal xyz, 2 emission}
+//   light:  (s * 6 + face) * 3 + ch       ch 0 direct (D), 1 bounce (B1), 2 bounce 2 (B2)
+//   pre:    (s * 16 + dir) * 3 + ch       light of ch seen along dir, premultiplied by opacity
+
+// Cone half-angle of the 16 cones: solid angle 4 pi / 16 = pi / 4, so
+// cos = 7/8 and tan = sqrt(15) / 7.
+GI_CONST float kTanHalf = 0.5532833352f;
+GI_CONST float kConeSolidAngle = 0.7853981634f;
+GI_CONST float kPi = 3.1415926536f;
+GI_CONST int kFlagPrecombined = 1;
+GI_CONST int kFlagNearFar = 2;
+GI_CONST int kMaxSteps = 160;
+
+int gi_n() { return P.iparams.x; }
+int gi_k() { return P.iparams.y; }
+int gi_flags() { return P.iparams.z; }
+int gi_lights() { return P.iparams.w; }
+float gi_s0() { return P.fparams.x; }
+float level_size(int l) { return gi_s0() * float(1 << l); }
+
+vec3 voxel_centre(int l, ivec3 c) { return (vec3(IXYZ(P.lo[l]) + c) + vec3(0.5f)) * level_size(l); }
+
+int voxel_index(int l, ivec3 c) {
+  int n = gi_n();
+  return l * n * n * n + (c.z * n + c.y) * n + c.x;
+}
+
+// Face f of a voxel that a cone travelling along d sees on axis a: the face
+// looking back toward the cone's apex. Weights d[a]^2 sum to 1.
+int facing_face(vec3 d, int a) { return 2 * a + (d[a] > 0.0f ? 1 : 0); }
+
+float blend_alpha(int voxel, vec3 d) {
+  float r = 0.0f;
+  for (int a = 0; a < 3; ++a) r += d[a] * d[a] * occ_load(voxel * 6 + facing_face(d, a));
+  return r;
+}
+
+// Light of channel ch of surface voxel s seen along d, premultiplied by the
+// faces' opacity (three lookups: the path the precombined buffer saves).
+vec3 blend_light(int s, int voxel, vec3 d, int ch) {
+  vec3 r = vec3(0.0f);
+  for (int a = 0; a < 3; ++a) {
+    int f = facing_face(d, a);
+    r += (d[a] * d[a] * occ_load(voxel * 6 + f)) * XYZ(light_load((s * 6 + f) * 3 + ch));
+  }
+  return r;
+}
+
+struct ConeSample {
+  float alpha;
+  vec3 d;
+  vec3 b1;
+  vec3 b2;
+};
+
+// A trilinear corner whose voxel is not wholly ahead of the plane through
+// the cone's apex normal to d is skipped: at the coarse levels a cone
+// reaches, such a voxel holds the very surface the cone starts from (its
+// faces say "opaque from outside" while the apex is inside it), and
+// counting it made surfaces occlude themselves wherever they do not lie on
+// the level's voxel faces (a slab's underside at z = -0.6 m received 63%
+// of a uniform sky, its top at z = 0 98%).
+void sample_corner(int l, ivec3 c, int dir, float w, vec3 apex, INOUT(ConeSample) cs) {
+  vec3 d = XYZ(P.dirs[dir]);
+  float support = 0.5f * level_size(l) * (abs(d.x) + abs(d.y) + abs(d.z));
+  if (dot(voxel_centre(l, c) - apex, d) <= support) return;
+  int voxel = voxel_index(l, c);
+  bool pre = (gi_flags() & kFlagPrecombined) != 0;
+  cs.alpha += w * (pre ? alpha_load(voxel * 16 + dir) : blend_alpha(voxel, d));
+  int s = vmap_load(voxel);
+  if (s < 0) return;
+  if (pre) {
+    cs.d += w * XYZ(pre_load((s * 16 + dir) * 3 + 0));
+    cs.b1 += w * XYZ(pre_load((s * 16 + dir) * 3 + 1));
+    cs.b2 += w * XYZ(pre_load((s * 16 + dir) * 3 + 2));
+  } else {
+    cs.d += w * blend_light(s, voxel, d, 0);
+    cs.b1 += w * blend_light(s, voxel, d, 1);
+    cs.b2 += w * blend_light(s, voxel, d, 2);
+  }
+}
+
+// Continuous voxel coordinates of p at level l (voxel centres at whole
+// numbers); true when the 8 trilinear corners lie inside the level.
+bool level_coords(int l, vec3 p, OUT(vec3) u) {
+  u = p / level_size(l) - vec3(IXYZ(P.lo[l])) - vec3(0.5f);
+  float hi = float(gi_n() - 1);
+  return u.x >= 0.0f && u.y >= 0.0f && u.z >= 0.0f && u.x <= hi && u.y <= hi && u.z <= hi;
+}
+
+ConeSample sample_level(int l, vec3 u, int dir, vec3 apex) {
+  ConeSample cs;
+  cs.alpha = 0.0f;
+  cs.d = vec3(0.0f);
+  cs.b1 = vec3(0.0f);
+  cs.b2 = vec3(0.0f);
+  int hi = gi_n() - 1;
+  ivec3 c0 = min(ivec3(floor(u)), ivec3(hi - 1));
+  vec3 f = u - vec3(c0);
+  for (int k = 0; k < 8; ++k) {
+    ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+    float w = (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) * (o.z == 1 ? f.z : 1.0f - f.z);
+    if (w > 0.0f) sample_corner(l, c0 + o, dir, w, apex, cs);
+  }
+  return cs;
+}
+
+// Weight of direction i in the normalised spherical radial basis (Gaussian
+// lobes of sharpness P.fparams.w around the 16 directions; they sum to 1).
+float rbf_weight(vec3 w, int i) {
+  float lambda = P.fparams.w;
+  float sum = 0.0f;
+  float mine = 0.0f;
+  for (int j = 0; j < 16; ++j) {
+    float g = exp(lambda * (dot(w, XYZ(P.dirs[j])) - 1.0f));
+    sum += g;
+    if (j == i) mine = g;
+  }
+  return mine / sum;
+}
+
+// What one cone gathers: light of the three buffers, point lights and
+// sky, each already multiplied by the transmittance in front of it.
+struct ConeResult {
+  vec3 src;  // sky + point lights
+  vec3 d;
+  vec3 b1;
+  vec3 b2;
+  float transmittance;
+};
+
+// Marches the cone along dir from apex (relative to the lattice origin)
+// starting at distance t0 at level l0 or coarser; point lights are picked up
+// where the march passes their distance, with the occlusion gathered so far.
+ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) {
+  ConeResult r;
+  r.src = vec3(0.0f);
+  r.d = vec3(0.0f);
+  r.b1 = vec3(0.0f);
+  r.b2 = vec3(0.0f);
+  float T = 1.0f;
+  vec3 d = XYZ(P.dirs[dir]);
+  float t = t0;
+  float base = level_size(l0);
+  bool escaped = false;
+  for (int step = 0; step < kMaxSteps; ++step) {
+    float diam = max(2.0f * kTanHalf * t, base);
+    int l = l0;
+    while (l + 1 < gi_k() && level_size(l + 1) <= diam) ++l;
+    vec3 p = apex + t * d;
+    vec3 u = vec3(0.0f);
+    while (l < gi_k() && !level_coords(l, p, u)) ++l;
+    if (l == gi_k()) {
+      escaped = true;
+      break;
+    }
+    float dt = 0.5f * level_size(l);
+    // Point lights between t and t + dt.
+    for (int i = 0; i < gi_lights(); ++i) {
+      float rl = length(XYZ(P.light_pos[i]) - apex);
+      if (rl >= t && rl < t + dt) {
+        vec3 wl = (XYZ(P.light_pos[i]) - apex) / rl;
+        r.src += (T * rbf_weight(wl, dir) / (kConeSolidAngle * rl * rl)) * XYZ(P.light_int[i]);
+      }
+    }
+    ConeSample cs = sample_level(l, u, dir, apex);
+    float a = min(cs.alpha, 1.0f);
+    // Opacity of half a voxel: 1 - (1 - a)^(1/2); the premultiplied light scales alike.
+    float ac = 1.0f - sqrt(1.0f - a);
+    float k = a > 0.0f ? ac / a : 0.5f;
+    r.d += (T * k) * cs.d;
+    r.b1 += (T * k) * cs.b1;
+    r.b2 += (T * k) * cs.b2;
+    T *= 1.0f - ac;
+    t += dt;
+    if (T < 1e-4f) break;
+  }
+  // Lights past the end of the march (outside the cascades) are unoccluded beyond it.
+  if (escaped) {
+    for (int i = 0; i < gi_lights(); ++i) {
+      float rl = length(XYZ(P.light_pos[i]) - apex);
+      if (rl >= t) {
+        vec3 wl = (XYZ(P.light_pos[i]) - apex) / rl;
+        r.src += (T * rbf_weight(wl, dir) / (kConeSolidAngle * rl * rl)) * XYZ(P.light_int[i]);
+      }
+    }
+    r.src += T * XYZ(P.sky[dir]);
+  }
+  r.transmittance = T;
+  return r;
+}
+
+// Cosine weights of the 16 directions for normal n, normalised so that a
+// uniform radiance L gives irradiance pi L exactly; returns their sum.
+float cosine_sum(vec3 n) {
+  float sum = 0.0f;
+  for (int i = 0; i < 16; ++i) sum += max(0.0f, dot(n, XYZ(P.dirs[i])));
+  return sum;
+}
+
+vec3 face_axis_normal(int f) {
+  vec3 n = vec3(0.0f);
+  n[f / 2] = (f % 2 == 0) ? 1.0f : -1.0f;
+  return n;
+}
+
+// Kernel 1: precombined opacity of every voxel along every direction (once per upload).
+void kernel_alpha(int gid) {
+  int total = gi_k() * gi_n() * gi_n() * gi_n() * 16;
+  if (gid >= total) return;
+  int voxel = gid / 16;
+  int dir = gid % 16;
+  alpha_store(gid, blend_alpha(voxel, XYZ(P.dirs[dir])));
+}
+
+// Kernel 2: precombined light of surface voxels pc.first .. + pc.count along every direction.
+void kernel_precombine(int gid) {
+  if (gid >= pc.count * 16) return;
+  int s = pc.first + gid / 16;
+  int dir = gid % 16;
+  ivec4 sp = surf_pos_load(s);
+  int voxel = voxel_index(sp.w, IXYZ(sp));
+  vec3 d = XYZ(P.dirs[dir]);
+  for (int ch = 0; ch < 3; ++ch) pre_store((s * 16 + dir) * 3 + ch, vec4(blend_light(s, voxel, d, ch), 0.0f));
+}
+
+// Kernel 3: one pass of the lighting update of surface voxels pc.first ..
+// + pc.count: 16 cones from the voxel's centre; from the previous frame's
+// buffers, direct light (sky, point lights, emission), first bounce (from
+// D) and second bounce (from B1) all at once.
+void kernel_update(int gid) {
+  if (gid >= pc.count) return;
+  int s = pc.first + gid;
+  ivec4 sp = surf_pos_load(s);
+  int l = sp.w;
+  vec3 apex = voxel_centre(l, IXYZ(sp));
+  vec3 src[16];
+  vec3 gd[16];
+  vec3 gb1[16];
+  for (int i = 0; i < 16; ++i) {
+    ConeResult cr = trace_cone(apex, i, l, level_size(l));
+    src[i] = cr.src;
+    gd[i] = cr.d;
+    gb1[i] = cr.b1;
+  }
+  for (int f = 0; f < 6; ++f) {
+    vec4 albedo = attr_load((s * 6 + f) * 3 + 0);
+    vec3 n = XYZ(attr_load((s * 6 + f) * 3 + 1));
+    vec3 emission = XYZ(attr_load((s * 6 + f) * 3 + 2));
+    if (albedo.w <= 0.0f) {
+      for (int ch = 0; ch < 3; ++ch) light_store((s * 6 + f) * 3 + ch, vec4(0.0f));
+      continue;
+    }
+    if (dot(n, n) < 0.5f) n = face_axis_normal(f);
+    float wsum = cosine_sum(n);
+    vec3 es = vec3(0.0f);
+    vec3 ed = vec3(0.0f);
+    vec3 eb = vec3(0.0f);
+    for (int i = 0; i < 16; ++i) {
+      float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
+      es += c * src[i];
+      ed += c * gd[i];
+      eb += c * gb1[i];
+    }
+    vec3 rho = XYZ(albedo) / wsum;
+    light_store((s * 6 + f) * 3 + 0, vec4(emission + rho * es, 0.0f));
+    light_store((s * 6 + f) * 3 + 1, vec4(rho * ed, 0.0f));
+    light_store((s * 6 + f) * 3 + 2, vec4(rho * eb, 0.0f));
+  }
+}
+
+// The optional third bounce: where the second bounce is as strong as the
+// first, extrapolate one more (B2 * B2 / B1, at most B2), scaled by boost.
+vec3 third_bounce(vec3 b1, vec3 b2) {
+  vec3 ratio = min(b2 / max(b1, vec3(1e-12f)), vec3(1.0f));
+  return P.fparams.y * b2 * ratio;
+}
+
+// Kernel 4: irradiance at query points pc.first .. + pc.count (pc.level =
+// bounces 1..3): qin[2i] = position (relative to the lattice origin),
+// qin[2i + 1] = unit normal; writes qout[i] = irradiance rgb, w = the
+// level traced from (-1 outside every level: sky only).
+void kernel_query(int gid) {
+  if (gid >= pc.count) return;
+  int q = pc.first + gid;
+  vec3 p = XYZ(qin_load(2 * q));
+  vec3 n = XYZ(qin_load(2 * q + 1));
+  int l0 = 0;
+  vec3 u = vec3(0.0f);
+  while (l0 < gi_k() && !level_coords(l0, p, u)) ++l0;
+  if (l0 == gi_k()) l0 = gi_k() - 1;
+  float s = level_size(l0);
+  vec3 apex = p + (P.fparams.z * s) * n;
+  float wsum = cosine_sum(n);
+  vec3 e = vec3(0.0f);
+  int bounces = pc.level;
+  for (int i = 0; i < 16; ++i) {
+    float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
+    if (c <= 0.0f) continue;
+    ConeResult cr = trace_cone(apex, i, l0, 0.5f * s);
+    vec3 l = cr.src + cr.d;
+    if (bounces >= 2) l += cr.b1;
+    if (bounces >= 3) l += cr.b2 + third_bounce(cr.b1, cr.b2);
+    e += c * l;
+  }
+  qout_store(q, vec4(e * (kPi / wsum), float(l0)));
+}

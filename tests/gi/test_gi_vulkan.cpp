@@ -1,0 +1,152 @@
+// The Vulkan engine (lavapipe on machines without a GPU) against the CPU
+// reference: same kernels, so the same light buffers and irradiance to
+// float rounding. Tolerance: |gpu - cpu| <= 1e-3 * (1 + |cpu|) per channel
+// (lavapipe may fuse multiply-adds and round exp/sqrt differently).
+// Skips with a message when no Vulkan device exists.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "gi/gi_scenes.h"
+#include "gi_bridge/gi.h"
+
+namespace ldc {
+namespace {
+
+using test::GiBox;
+
+constexpr float kTolerance = 1e-3f;
+
+std::unique_ptr<GiEngine> vulkan_or_skip(const GiConfig& config = {}) {
+  std::string device;
+  Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi(config, &device);
+  if (!gi.ok()) {
+    std::printf("no Vulkan device: %s\n", gi.status().message().c_str());
+    return nullptr;
+  }
+  std::printf("Vulkan device: %s\n", device.c_str());
+  return std::move(gi).value();
+}
+
+float worst(const glm::vec3& a, const glm::vec3& b) {
+  const glm::vec3 d = glm::abs(a - b) / (1.0f + glm::abs(b));
+  return std::max({d.x, d.y, d.z});
+}
+
+struct Scene {
+  World world;
+  Cascades cascades;
+  GiLights lights;
+};
+
+Scene lit_room() {
+  std::vector<GiBox> boxes = test::closed_room(0);
+  boxes[5].hi.z = 0.0;                                // the +y wall open above z = 0
+  boxes[2].material = 3;                               // red -x wall
+  boxes[3].material = 4;                               // green +x wall
+  boxes.push_back({{-0.4, -0.4, 0.6}, {0.4, 0.4, 1.0}, 2});  // emitter in the ceiling
+  World w = test::build_boxes(boxes);
+  Cascades c = test::make_cascades(w, glm::dvec3(0.0));
+  GiLights l;
+  l.sky = SkyLight::gradient(glm::vec3(0.6f, 0.8f, 1.2f), glm::vec3(1.0f), glm::vec3(0.2f));
+  l.points.push_back({glm::dvec3(0.4, -0.3, -0.2), glm::vec3(1.5f, 1.2f, 0.8f)});
+  return {std::move(w), std::move(c), std::move(l)};
+}
+
+void expect_engines_agree(const GiConfig& config, int passes) {
+  auto gpu = vulkan_or_skip(config);
+  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  const Scene scene = lit_room();
+  auto cpu = make_cpu_gi(config);
+  for (GiEngine* g : {gpu.get(), cpu.get()}) {
+    ASSERT_TRUE(g->load(scene.cascades, scene.lights).ok());
+    ASSERT_TRUE(g->update_all(passes).ok());
+  }
+  Result<GiRadiance> rg = gpu->radiance(), rc = cpu->radiance();
+  ASSERT_TRUE(rg.ok() && rc.ok());
+  ASSERT_EQ(rg.value().voxels.size(), rc.value().voxels.size());
+  float max_err = 0.0f, max_value = 0.0f;
+  for (size_t s = 0; s < rc.value().light.size(); ++s) {
+    for (size_t j = 0; j < 18; ++j) {
+      max_err = std::max(max_err, worst(rg.value().light[s][j], rc.value().light[s][j]));
+      max_value = std::max(max_value, rc.value().light[s][j].g);
+    }
+  }
+  EXPECT_GT(max_value, 0.1f);
+  EXPECT_LE(max_err, kTolerance) << "light buffers";
+  std::vector<glm::dvec3> p;
+  std::vector<glm::vec3> n;
+  for (int i = 0; i < 64; ++i) {
+    p.emplace_back(-0.75 + 0.023 * i, 0.3 - 0.01 * i, -0.8);
+    n.emplace_back(0, 0, 1);
+    p.emplace_back(0.8, -0.7 + 0.02 * i, -0.7 + 0.02 * i);
+    n.emplace_back(-1, 0, 0);
+  }
+  for (int bounces = 1; bounces <= 3; ++bounces) {
+    std::vector<glm::vec3> eg(p.size()), ec(p.size());
+    ASSERT_TRUE(gpu->irradiance(p, n, bounces, eg).ok());
+    ASSERT_TRUE(cpu->irradiance(p, n, bounces, ec).ok());
+    float err = 0.0f;
+    for (size_t i = 0; i < p.size(); ++i) err = std::max(err, worst(eg[i], ec[i]));
+    EXPECT_LE(err, kTolerance) << "irradiance, " << bounces << " bounces";
+    EXPECT_GT(ec[0].g, 0.0f);
+  }
+}
+
+TEST(GiVulkan, MatchesTheCpuReferencePrecombined) { expect_engines_agree(GiConfig{}, 3); }
+
+TEST(GiVulkan, MatchesTheCpuReferenceWithThreeFaceLookups) {
+  GiConfig c;
+  c.precombined = false;
+  c.third_bounce_boost = 1.0f;
+  expect_engines_agree(c, 2);
+}
+
+TEST(GiVulkan, ClosedRoomIsBlackInside) {
+  auto gpu = vulkan_or_skip();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  const World world = test::build_boxes(test::closed_room());
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  GiLights lights;
+  lights.sky = SkyLight::uniform(glm::vec3(1.0f));
+  ASSERT_TRUE(gpu->load(cas, lights).ok());
+  ASSERT_TRUE(gpu->update_all(3).ok());
+  std::vector<glm::vec3> e(2);
+  ASSERT_TRUE(gpu->irradiance(std::vector<glm::dvec3>{{0, 0, -0.8}, {0, 0, 2.4}},
+                              std::vector<glm::vec3>{{0, 0, 1}, {0, 0, 1}}, 3, e).ok());
+  EXPECT_LT(e[0].g, 3e-3f);  // under 0.1% of the sky outside (as GiCpu.ClosedRoomWithSkyOutsideIsBlackInside)
+  EXPECT_GT(e[1].g, 1.0f);
+}
+
+TEST(GiVulkan, SkyOnlyOpenPlaneGetsTheAnalyticIrradiance) {
+  auto gpu = vulkan_or_skip();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  const World world = test::build_boxes({{{-30, -30, -1}, {30, 30, 0}, 1}});
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  GiLights lights;
+  lights.sky = SkyLight::uniform(glm::vec3(1.0f));
+  ASSERT_TRUE(gpu->load(cas, lights).ok());
+  ASSERT_TRUE(gpu->update_all(1).ok());
+  std::vector<glm::vec3> e(1);
+  ASSERT_TRUE(gpu->irradiance(std::vector<glm::dvec3>{{0.3, 0.1, 0}}, std::vector<glm::vec3>{{0, 0, 1}}, 1, e).ok());
+  EXPECT_NEAR(e[0].g, 3.14159f, 0.1f * 3.14159f) << "tolerance 10%";
+}
+
+TEST(GiVulkan, StaggeredFramesUpdateOneLevelEach) {
+  GiConfig c;
+  c.staggered = true;
+  auto gpu = vulkan_or_skip(c);
+  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  const Scene scene = lit_room();
+  ASSERT_TRUE(gpu->load(scene.cascades, scene.lights).ok());
+  for (int f = 0; f < 8; ++f) {
+    Result<GiTimings> t = gpu->frame();
+    ASSERT_TRUE(t.ok());
+    EXPECT_EQ(t.value().levels_updated, 1);
+  }
+}
+
+}  // namespace
+}  // namespace ldc

@@ -1,0 +1,204 @@
+// The CPU reference of gi_bridge on small scenes: the physical cases the
+// algorithm must get right (the Vulkan engine is held to the same results
+// by tests/gi/test_gi_vulkan.cpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "gi/gi_scenes.h"
+#include "gi_bridge/gi.h"
+
+namespace ldc {
+namespace {
+
+using test::GiBox;
+
+float luminance(const glm::vec3& c) { return (c.r + c.g + c.b) / 3.0f; }
+
+TEST(GiDirections, AreASphericalFiveDesign) {
+  // Mean of x^a y^b z^c over the directions equals the sphere's average for degree <= 5
+  // (to the table's float rounding and the optimiser's residual, about 1e-5).
+  const auto& d = gi_directions();
+  glm::dvec3 sum(0.0);
+  double xx = 0, zz = 0, xy = 0, z4 = 0, x2y2 = 0;
+  for (const glm::vec3& v : d) {
+    EXPECT_NEAR(glm::length(v), 1.0f, 1e-6f);
+    sum += glm::dvec3(v);
+    xx += v.x * v.x, zz += v.z * v.z, xy += v.x * v.y;
+    z4 += std::pow(v.z, 4), x2y2 += v.x * v.x * v.y * v.y;
+  }
+  EXPECT_NEAR(glm::length(sum) / 16, 0.0, 2e-5);
+  EXPECT_NEAR(xx / 16, 1.0 / 3.0, 2e-5);
+  EXPECT_NEAR(zz / 16, 1.0 / 3.0, 2e-5);
+  EXPECT_NEAR(xy / 16, 0.0, 2e-5);
+  EXPECT_NEAR(z4 / 16, 1.0 / 5.0, 2e-5);
+  EXPECT_NEAR(x2y2 / 16, 1.0 / 15.0, 2e-5);
+}
+
+TEST(GiSky, UniformSkyIsExactInTheLobeBasis) {
+  const SkyLight sky = SkyLight::uniform(glm::vec3(0.5f, 1.0f, 2.0f));
+  for (const glm::vec3 w : {glm::vec3(0, 0, 1), glm::normalize(glm::vec3(1, 2, -3))}) {
+    const glm::vec3 r = sky.radiance(w);
+    EXPECT_NEAR(r.x, 0.5f, 1e-5f);
+    EXPECT_NEAR(r.z, 2.0f, 1e-5f);
+  }
+}
+
+TEST(GiConfig, BadValuesAreNamed) {
+  GiConfig c;
+  c.third_bounce_boost = 2.0f;
+  EXPECT_NE(check_gi_config(c).message().find("third_bounce_boost 2"), std::string::npos);
+  GiLights l;
+  l.points.resize(9);
+  EXPECT_NE(check_gi_lights(l).message().find("9 point lights"), std::string::npos);
+}
+
+TEST(GiCpu, ClosedRoomWithSkyOutsideIsBlackInside) {
+  const World world = test::build_boxes(test::closed_room());
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  GiLights lights;
+  lights.sky = SkyLight::uniform(glm::vec3(1.0f));
+  ASSERT_TRUE(gi->load(cas, lights).ok());
+  ASSERT_TRUE(gi->update_all(3).ok());
+  const std::vector<glm::dvec3> p = {{0, 0, -0.8}, {0, 0, 0.8}, {0.8, 0.3, 0.2}, {0, 0, 0}};
+  const std::vector<glm::vec3> n = {{0, 0, 1}, {0, 0, -1}, {-1, 0, 0}, {0, 1, 0}};
+  std::vector<glm::vec3> e(p.size());
+  ASSERT_TRUE(gi->irradiance(p, n, 3, e).ok());
+  // Under 0.1% of the sky's pi outside: the coarsest voxels holding both the
+  // room and its walls are not counted by cones starting inside them (see
+  // sample_corner), which lets about 5e-4 of the sky through.
+  for (const glm::vec3& v : e) EXPECT_LT(luminance(v), 3e-3f);
+  // Outside, the roof sees the sky.
+  std::vector<glm::vec3> top(1);
+  ASSERT_TRUE(gi->irradiance(std::vector<glm::dvec3>{{0, 0, 2.4}}, std::vector<glm::vec3>{{0, 0, 1}}, 1, top).ok());
+  EXPECT_GT(luminance(top[0]), 1.0f);
+}
+
+TEST(GiCpu, NoLightAtAllGivesExactZeros) {
+  const World world = test::build_boxes(test::closed_room());
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  ASSERT_TRUE(gi->load(cas, GiLights{}).ok());
+  ASSERT_TRUE(gi->update_all(2).ok());
+  Result<GiRadiance> r = gi->radiance();
+  ASSERT_TRUE(r.ok());
+  ASSERT_GT(r.value().voxels.size(), 100u);
+  for (const auto& faces : r.value().light)
+    for (const glm::vec3& v : faces) ASSERT_EQ(luminance(v), 0.0f);
+}
+
+// Sky of radiance 1 over a black open plane: irradiance pi facing up.
+TEST(GiCpu, SkyOnlyOpenPlaneGetsTheAnalyticIrradiance) {
+  const World world = test::build_boxes({{{-30, -30, -1}, {30, 30, 0}, 1}});
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  GiLights lights;
+  lights.sky = SkyLight::uniform(glm::vec3(1.0f));
+  ASSERT_TRUE(gi->load(cas, lights).ok());
+  ASSERT_TRUE(gi->update_all(1).ok());
+  const std::vector<glm::dvec3> p = {{0, 0, 0}, {0.5, -0.7, 0}, {1.1, 0.3, 0}};
+  const std::vector<glm::vec3> n(p.size(), glm::vec3(0, 0, 1));
+  std::vector<glm::vec3> e(p.size());
+  ASSERT_TRUE(gi->irradiance(p, n, 1, e).ok());
+  for (const glm::vec3& v : e) EXPECT_NEAR(v.g, 3.14159f, 0.1f * 3.14159f) << "tolerance 10%";
+  // The voxels' own direct light: the up faces of the black plane reflect nothing.
+  Result<GiRadiance> r = gi->radiance();
+  ASSERT_TRUE(r.ok());
+  for (const auto& faces : r.value().light) EXPECT_EQ(luminance(faces[4 * 3]), 0.0f);
+}
+
+// A 0.2 m wall (one voxel) with a point light 0.8 m in front of it: the lit
+// side gets about I / r^2, the far side (and its voxel faces) nothing.
+TEST(GiCpu, ThinWallLitOnOneSideDoesNotLeak) {
+  const World world = test::build_boxes({{{0.0, -20, -20}, {0.2, 20, 20}, 0}});
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.1, 0, 0));
+  auto gi = make_cpu_gi();
+  GiLights lights;
+  lights.points.push_back({glm::dvec3(1.0, 0.1, 0.1), glm::vec3(1.0f)});
+  ASSERT_TRUE(gi->load(cas, lights).ok());
+  ASSERT_TRUE(gi->update_all(3).ok());
+  const std::vector<glm::dvec3> p = {{0.2, 0.1, 0.1}, {0.0, 0.1, 0.1}};
+  const std::vector<glm::vec3> n = {{1, 0, 0}, {-1, 0, 0}};
+  std::vector<glm::vec3> e(2);
+  ASSERT_TRUE(gi->irradiance(p, n, 3, e).ok());
+  EXPECT_GT(luminance(e[0]), 0.5f);  // 1 / 0.8^2 = 1.56 facing the light
+  EXPECT_LT(luminance(e[1]), 0.01f * luminance(e[0]));
+  Result<GiRadiance> r = gi->radiance();
+  ASSERT_TRUE(r.ok());
+  float lit = 0, dark = 0;
+  for (size_t s = 0; s < r.value().voxels.size(); ++s) {
+    if (r.value().voxels[s].w != 0 || r.value().voxels[s].x != 0) continue;  // the wall's level-0 voxels
+    lit += luminance(r.value().light[s][0 * 3]);   // +x face, D
+    dark += luminance(r.value().light[s][1 * 3]);  // -x face, D
+  }
+  EXPECT_GT(lit, 0.0f);
+  EXPECT_EQ(dark, 0.0f);
+}
+
+// A closed room with an emitter: each bounce carries less light than the one before.
+TEST(GiCpu, EnergyDoesNotGrowWithBounces) {
+  std::vector<GiBox> boxes = test::closed_room();
+  boxes.push_back({{-0.4, -0.4, 0.6}, {0.4, 0.4, 1.0}, 2});  // emitter in the ceiling
+  const World world = test::build_boxes(boxes);
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  ASSERT_TRUE(gi->load(cas, GiLights{}).ok());
+  ASSERT_TRUE(gi->update_all(3).ok());
+  Result<GiRadiance> r = gi->radiance();
+  ASSERT_TRUE(r.ok());
+  double sum[3] = {0, 0, 0};
+  for (const auto& faces : r.value().light)
+    for (int f = 0; f < 6; ++f)
+      for (int ch = 0; ch < 3; ++ch) sum[ch] += luminance(faces[size_t(f * 3 + ch)]);
+  EXPECT_GT(sum[0], 0.0);
+  EXPECT_GT(sum[1], 0.0);
+  EXPECT_LT(sum[1], sum[0]);
+  EXPECT_LT(sum[2], sum[1]);
+  std::vector<glm::vec3> e1(1), e2(1), e3(1);
+  const std::vector<glm::dvec3> p = {{0, 0, -0.8}};
+  const std::vector<glm::vec3> n = {{0, 0, 1}};
+  ASSERT_TRUE(gi->irradiance(p, n, 1, e1).ok());
+  ASSERT_TRUE(gi->irradiance(p, n, 2, e2).ok());
+  ASSERT_TRUE(gi->irradiance(p, n, 3, e3).ok());
+  EXPECT_GT(luminance(e1[0]), 0.0f);
+  EXPECT_LT(luminance(e2[0]) - luminance(e1[0]), luminance(e1[0]));
+  EXPECT_LT(luminance(e3[0]) - luminance(e2[0]), luminance(e2[0]) - luminance(e1[0]));
+}
+
+TEST(GiCpu, PrecombinedAndThreeFaceLookupsAgree) {
+  std::vector<GiBox> boxes = test::closed_room(3);
+  boxes[5].hi.z = 0.0;  // open the +y wall's upper half to the sky
+  const World world = test::build_boxes(boxes);
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  GiLights lights;
+  lights.sky = SkyLight::uniform(glm::vec3(1.0f));
+  lights.points.push_back({glm::dvec3(0.3, 0.2, 0.3), glm::vec3(2.0f)});
+  GiConfig a, b;
+  b.precombined = false;
+  auto ga = make_cpu_gi(a), gb = make_cpu_gi(b);
+  for (auto* g : {ga.get(), gb.get()}) {
+    ASSERT_TRUE(g->load(cas, lights).ok());
+    ASSERT_TRUE(g->update_all(3).ok());
+  }
+  const std::vector<glm::dvec3> p = {{0, 0, -0.8}, {0.5, 0.8, -0.5}, {-0.8, 0, 0}};
+  const std::vector<glm::vec3> n = {{0, 0, 1}, {0, -1, 0}, {1, 0, 0}};
+  std::vector<glm::vec3> ea(3), eb(3);
+  ASSERT_TRUE(ga->irradiance(p, n, 3, ea).ok());
+  ASSERT_TRUE(gb->irradiance(p, n, 3, eb).ok());
+  for (size_t i = 0; i < 3; ++i) {
+    EXPECT_GT(luminance(ea[i]), 0.0f);
+    EXPECT_NEAR(luminance(ea[i]), luminance(eb[i]), 1e-4f * (1.0f + luminance(eb[i])));
+  }
+}
+
+TEST(GiCpu, QueriesBeforeLoadAreRefused) {
+  auto gi = make_cpu_gi();
+  std::vector<glm::vec3> e(1);
+  Status s = gi->irradiance(std::vector<glm::dvec3>{{0, 0, 0}}, std::vector<glm::vec3>{{0, 0, 1}}, 1, e);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("load()"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace ldc
