@@ -107,6 +107,20 @@ struct GiConfig {
   // Third bounce boost: B2 * min(1, B2 / B1) * boost added to queries with
   // 3 bounces. [Limit: 0 .. 1] [Default: 0 (off)]
   float third_bounce_boost = 0.0f;
+  // Near/far split cones (the talk's "split cone trace"): the far part of
+  // each of the 16 cones (from near_far_split voxels on) is traced once per
+  // surface voxel from its centre and shared by its six faces; the near
+  // part is marched per face from the face (half a voxel out along its
+  // normal) up to where the far part starts, and the far part is
+  // composited behind it (L_near + T_near * L_far). Off: the centre's
+  // cones, from one voxel on, are shared whole by the faces (cheaper; the
+  // faces then see no detail nearer than a voxel from the centre).
+  // Measured in the closing note (/tmp/scratch/note8.md, "Near/far split
+  // cones"). [Default: off]
+  bool near_far = false;
+  // Where the far part starts. [Units: voxels of the updated level] [Limit: 1 .. 16] [Default: 2.5 (the
+  // talk: about a metre at its 0.4 m voxels)]
+  float near_far_split = 2.5f;
   // Query apex offset along the normal. [Units: voxels of the start level] [Limit: 0 .. 4] [Default: 1]
   float query_offset = 1.0f;
 };
