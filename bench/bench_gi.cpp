@@ -3,7 +3,8 @@
 // open to the sky with an emitter and a point light, the default landscape
 // with a dug cave, and one shared mesh (spot) on a ground slab — with six
 // levels of 32^3 voxels: time per level update and per full update (with
-// and without the precombined buffers), a staggered frame, and the error of
+// and without the precombined buffers, and with the near/far split cones),
+// a staggered frame, and the error (near/far split off and on) of
 // the cone-traced irradiance against the path-traced reference (Embree on
 // the contoured mesh) at the same points, for 1, 2 and 3 bounces.
 // Usage: bench_gi [points (200)] [paths per point (512)]
@@ -162,7 +163,7 @@ void run(const Scene& s, int points, int paths) {
     return;
   }
   std::string device;
-  std::vector<glm::vec3> gi_e[3];
+  std::vector<glm::vec3> gi_e[2][3];  // [near/far split off, on][bounces - 1]
   Result<ContourMesh> mesh = contour_world(s.world);
   if (!mesh.ok()) return;
   std::vector<glm::dvec3> p;
@@ -170,12 +171,14 @@ void run(const Scene& s, int points, int paths) {
   query_points(mesh.value(), s.camera, 1.5, points, p, n);
   std::printf("cascades: 6 levels of 32^3, level 0 voxel %.3g m; %zu query points within 1.5 m of the camera\n",
               cc.voxel_size, p.size());
-  std::printf("| engine | precombined | load s | level 0 s | level 1 s | level 2 s | level 3 s | level 4 s | level 5 s | full update s | staggered frame s (mean of 16) | surface voxels |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-  // Vulkan (lavapipe here) with and without the precombined buffers, then the CPU engine for reference.
-  for (int run_i = 0; run_i < 3; ++run_i) {
-    const bool pre = run_i != 1, cpu = run_i == 2;
+  std::printf("| engine | precombined | near/far split | load s | level 0 s | level 1 s | level 2 s | level 3 s | level 4 s | level 5 s | full update s | staggered frame s (mean of 16) | surface voxels |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  // Vulkan (lavapipe here) with and without the precombined buffers and
+  // with the near/far split cones, then the CPU engine for reference.
+  for (int run_i = 0; run_i < 5; ++run_i) {
+    const bool pre = run_i != 1, cpu = run_i >= 3, split = run_i == 2 || run_i == 4;
     GiConfig gc;
     gc.precombined = pre;
+    gc.near_far = split;
     std::unique_ptr<GiEngine> engine;
     if (cpu) {
       engine = make_cpu_gi(gc);
@@ -191,7 +194,8 @@ void run(const Scene& s, int points, int paths) {
     auto t0 = Clock::now();
     if (!g.load(cas.value(), s.lights).ok()) return;
     const double load_s = since(t0);
-    std::printf("| %s | %s | %.3f |", cpu ? "cpu (2 threads)" : "vulkan", pre ? "on" : "off", load_s);
+    std::printf("| %s | %s | %s | %.3f |", cpu ? "cpu (2 threads)" : "vulkan", pre ? "on" : "off", split ? "on" : "off",
+                load_s);
     size_t surf = 0;
     for (int l = 0; l < 6; ++l) {
       Result<GiTimings> t = g.update_level(l);
@@ -209,8 +213,8 @@ void run(const Scene& s, int points, int paths) {
     if (pre && !cpu) {
       (void)g.update_all(3);
       for (int b = 1; b <= 3; ++b) {
-        gi_e[b - 1].resize(p.size());
-        (void)g.irradiance(p, n, b, gi_e[b - 1]);
+        gi_e[split][b - 1].resize(p.size());
+        (void)g.irradiance(p, n, b, gi_e[split][b - 1]);
       }
       t0 = Clock::now();
       std::vector<glm::vec3> tmp(p.size());
@@ -221,7 +225,7 @@ void run(const Scene& s, int points, int paths) {
   std::printf("device: %s\n", device.c_str());
   Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), s.materials, s.lights);
   if (!pt.ok()) return;
-  std::printf("| bounces | mean rel. error | p95 rel. error | mean cone-traced | mean path-traced | path tracer s | path samples |\n|---|---|---|---|---|---|---|\n");
+  std::printf("| near/far split | bounces | mean rel. error | p95 rel. error | mean cone-traced | mean path-traced | path tracer s | path samples |\n|---|---|---|---|---|---|---|---|\n");
   for (int b = 1; b <= 3; ++b) {
     std::vector<glm::vec3> ref(p.size());
     PathTraceConfig pc;
@@ -229,11 +233,14 @@ void run(const Scene& s, int points, int paths) {
     const auto t0 = Clock::now();
     (void)pt.value()->irradiance(p, n, b, ref, pc);
     const double pt_s = since(t0);
-    const Stats st = rel_error(gi_e[b - 1], ref);
-    double mg = 0, mr = 0;
-    for (size_t i = 0; i < p.size(); ++i) mg += lum(gi_e[b - 1][i]) / double(p.size()), mr += lum(ref[i]) / double(p.size());
-    std::printf("| %d | %.1f%% | %.1f%% | %.3f | %.3f | %.2f | %d paths x %zu points |\n", b, 100 * st.mean, 100 * st.p95, mg,
-                mr, pt_s, paths, p.size());
+    for (int split = 0; split < 2; ++split) {
+      const Stats st = rel_error(gi_e[split][b - 1], ref);
+      double mg = 0, mr = 0;
+      for (size_t i = 0; i < p.size(); ++i)
+        mg += lum(gi_e[split][b - 1][i]) / double(p.size()), mr += lum(ref[i]) / double(p.size());
+      std::printf("| %s | %d | %.1f%% | %.1f%% | %.3f | %.3f | %.2f | %d paths x %zu points |\n", split ? "on" : "off", b,
+                  100 * st.mean, 100 * st.p95, mg, mr, pt_s, paths, p.size());
+    }
   }
 }
 

@@ -86,6 +86,11 @@ Status check_gi_config(const GiConfig& config) {
     s << "third_bounce_boost " << config.third_bounce_boost << " must be in 0 .. 1";
     return bad(s.str());
   }
+  if (!(config.near_far_split >= 1.0f && config.near_far_split <= 16.0f)) {
+    std::ostringstream s;
+    s << "near_far_split " << config.near_far_split << " must be in 1 .. 16";
+    return bad(s.str());
+  }
   if (!(config.query_offset >= 0.0f && config.query_offset <= 4.0f)) {
     std::ostringstream s;
     s << "query_offset " << config.query_offset << " must be in 0 .. 4";
@@ -110,7 +115,9 @@ void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfi
   }
   p.fparams = glm::vec4(float(cascades.voxel_size(0)), config.third_bounce_boost, config.query_offset,
                         lights.sky.sharpness);
-  p.iparams = glm::ivec4(out.n, out.k, config.precombined ? 1 : 0, int(lights.points.size()));
+  p.iparams = glm::ivec4(out.n, out.k, (config.precombined ? 1 : 0) | (config.near_far ? 2 : 0),
+                         int(lights.points.size()));
+  p.fparams2 = glm::vec4(config.near_far_split, 0.0f, 0.0f, 0.0f);
   for (int l = 0; l < out.k; ++l) p.lo[l] = glm::ivec4(cascades.level_box(l).lo, 0);
 }
 

@@ -20,9 +20,10 @@ struct GiParams {
   glm::vec4 light_int[kGiMaxPointLights];
   glm::vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset, w RBF sharpness
   glm::ivec4 iparams;  // x N, y K, z flags, w point lights
+  glm::vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
   glm::ivec4 lo[kGiMaxLevels];
 };
-static_assert(sizeof(GiParams) == 16 * (16 + 16 + 8 + 8 + 1 + 1 + 16));
+static_assert(sizeof(GiParams) == 16 * (16 + 16 + 8 + 8 + 1 + 1 + 1 + 16));
 
 struct GiPush {
   int first = 0;

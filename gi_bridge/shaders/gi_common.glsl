@@ -147,7 +147,7 @@ struct ConeResult {
 // Marches the cone along dir from apex (relative to the lattice origin)
 // starting at distance t0 at level l0 or coarser; point lights are picked up
 // where the march passes their distance, with the occlusion gathered so far.
-ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) {
+ConeResult trace_cone_range(vec3 apex, int dir, int l0, float t0, float t1) {
   ConeResult r;
   r.src = vec3(0.0f);
   r.d = vec3(0.0f);
@@ -159,6 +159,7 @@ ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) {
   float base = level_size(l0);
   bool escaped = false;
   for (int step = 0; step < kMaxSteps; ++step) {
+    if (t >= t1) break;
     float diam = max(2.0f * kTanHalf * t, base);
     int l = l0;
     while (l + 1 < gi_k() && level_size(l + 1) <= diam) ++l;
@@ -173,7 +174,7 @@ ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) {
     // Point lights between t and t + dt.
     for (int i = 0; i < gi_lights(); ++i) {
       float rl = length(XYZ(P.light_pos[i]) - apex);
-      if (rl >= t && rl < t + dt) {
+      if (rl >= t && rl < min(t + dt, t1)) {
         vec3 wl = (XYZ(P.light_pos[i]) - apex) / rl;
         r.src += (T * rbf_weight(wl, dir) / (kConeSolidAngle * rl * rl)) * XYZ(P.light_int[i]);
       }
@@ -204,6 +205,9 @@ ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) {
   r.transmittance = T;
   return r;
 }
+
+// The whole cone (no end).
+ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) { return trace_cone_range(apex, dir, l0, t0, 1e30f); }
 
 // Cosine weights of the 16 directions for normal n, normalised so that a
 // uniform radiance L gives irradiance pi L exactly; returns their sum.
@@ -243,17 +247,28 @@ void kernel_precombine(int gid) {
 // + pc.count: 16 cones from the voxel's centre; from the previous frame's
 // buffers, direct light (sky, point lights, emission), first bounce (from
 // D) and second bounce (from B1) all at once.
+// Near/far split (flag kFlagNearFar, split distance ts = P.fparams2.x voxels
+// of the level): the 16 cones from the voxel's centre start at ts (the
+// "far" part, shared by the six faces, as the talk's far cones traced once
+// per voxel); each face then marches the "near" part of every cone on its
+// side (n . d > 0) from its own apex (voxel centre + half a voxel along n,
+// from half a voxel to the plane normal to d where the far part starts) and
+// composites the far part behind it: L = L_near + T_near * L_far. Without
+// the flag the centre's cones start at one voxel and are shared whole.
 void kernel_update(int gid) {
   if (gid >= pc.count) return;
   int s = pc.first + gid;
   ivec4 sp = surf_pos_load(s);
   int l = sp.w;
   vec3 apex = voxel_centre(l, IXYZ(sp));
+  bool split = (gi_flags() & kFlagNearFar) != 0;
+  float vs = level_size(l);
+  float ts = split ? P.fparams2.x * vs : vs;
   vec3 src[16];
   vec3 gd[16];
   vec3 gb1[16];
   for (int i = 0; i < 16; ++i) {
-    ConeResult cr = trace_cone(apex, i, l, level_size(l));
+    ConeResult cr = trace_cone(apex, i, l, ts);
     src[i] = cr.src;
     gd[i] = cr.d;
     gb1[i] = cr.b1;
@@ -271,11 +286,20 @@ void kernel_update(int gid) {
     vec3 es = vec3(0.0f);
     vec3 ed = vec3(0.0f);
     vec3 eb = vec3(0.0f);
+    vec3 apex_f = apex + (0.5f * vs) * n;
     for (int i = 0; i < 16; ++i) {
       float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
-      es += c * src[i];
-      ed += c * gd[i];
-      eb += c * gb1[i];
+      if (c <= 0.0f) continue;
+      if (split) {
+        ConeResult nr = trace_cone_range(apex_f, i, l, 0.5f * vs, ts - 0.5f * vs * c);
+        es += c * (nr.src + nr.transmittance * src[i]);
+        ed += c * (nr.d + nr.transmittance * gd[i]);
+        eb += c * (nr.b1 + nr.transmittance * gb1[i]);
+      } else {
+        es += c * src[i];
+        ed += c * gd[i];
+        eb += c * gb1[i];
+      }
     }
     vec3 rho = XYZ(albedo) / wsum;
     light_store((s * 6 + f) * 3 + 0, vec4(emission + rho * es, 0.0f));

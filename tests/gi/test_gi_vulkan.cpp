@@ -104,6 +104,15 @@ TEST(GiVulkan, MatchesTheCpuReferenceWithThreeFaceLookups) {
   expect_engines_agree(c, 2);
 }
 
+TEST(GiVulkan, MatchesTheCpuReferenceWithNearFarSplitCones) {
+  GiConfig c;
+  c.near_far = true;
+  expect_engines_agree(c, 3);
+  c.precombined = false;
+  c.near_far_split = 4.0f;
+  expect_engines_agree(c, 2);
+}
+
 TEST(GiVulkan, ClosedRoomIsBlackInside) {
   auto gpu = vulkan_or_skip();
   if (!gpu) GTEST_SKIP() << "no Vulkan device";
