@@ -194,7 +194,7 @@ void run(const Scene& s, int points, int paths) {
     auto t0 = Clock::now();
     if (!g.load(cas.value(), s.lights).ok()) return;
     const double load_s = since(t0);
-    std::printf("| %s | %s | %s | %.3f |", cpu ? "cpu (2 threads)" : "vulkan", pre ? "on" : "off", split ? "on" : "off",
+    std::printf("| %s | %s | %s | %.3f |", cpu ? "cpu" : device.c_str(), pre ? "on" : "off", split ? "on" : "off",
                 load_s);
     size_t surf = 0;
     for (int l = 0; l < 6; ++l) {
@@ -249,8 +249,7 @@ void run(const Scene& s, int points, int paths) {
 int main(int argc, char** argv) {
   const int points = argc > 1 ? std::atoi(argv[1]) : 200;
   const int paths = argc > 2 ? std::atoi(argv[2]) : 512;
-  std::printf("# bench_gi: cone-traced GI (Vulkan; lavapipe on this machine, no NVIDIA GPU lent) vs path-traced reference\n");
-  std::printf("No NVIDIA GPU was lent to this task: every Vulkan time below is Mesa's lavapipe (CPU), not a GPU.\n");
+  std::printf("# bench_gi: cone-traced GI (Vulkan engine rows name their device; llvmpipe = Mesa's lavapipe on the CPU) vs path-traced reference\n");
   run(cornell(), points, paths);
   run(landscape(), points, paths);
   run(shared_mesh(), points, paths);

@@ -41,8 +41,8 @@
 // Point lights (at most kGiMaxPointLights): radiant intensity I
 // [radiance * m^2]; a cone picks a light up at the step where its march
 // passes the light's distance r, with weight B_i(w_light) I / (Omega r^2) and
-// the transmittance gathered so far (NOT a cascaded volume: see the README of
-// the closing note; a light list instead of an injected volume texture).
+// the transmittance gathered so far (a light list, not yet the talk's
+// cascaded volume that lights are injected into).
 // Emission (MaterialTable) is written into D directly.
 //
 // Outputs: radiance() reads back the per-face light cascades; irradiance()

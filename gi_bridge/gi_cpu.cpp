@@ -85,12 +85,11 @@ class CpuGi final : public GiEngineBase {
   }
 
   Status run(GiKernel kernel, int first, int count, int level) override {
-    Kernels k{params_, GiPush{first, kernel == GiKernel::kPrecombine ? count / 16 : count, level, 0}, &b_};
-    const int items = count;
-    tbb::parallel_for(tbb::blocked_range<int>(0, items, 64), [&](const tbb::blocked_range<int>& r) {
+    Kernels k{params_, GiPush{first, count, level, 0}, &b_};
+    tbb::parallel_for(tbb::blocked_range<int>(0, count, 64), [&](const tbb::blocked_range<int>& r) {
       for (int gid = r.begin(); gid < r.end(); ++gid) {
         switch (kernel) {
-          case GiKernel::kAlpha: k.kernel_alpha(first + gid); break;
+          case GiKernel::kAlpha: k.kernel_alpha(gid); break;
           case GiKernel::kPrecombine: k.kernel_precombine(gid); break;
           case GiKernel::kUpdate: k.kernel_update(gid); break;
           case GiKernel::kQuery: k.kernel_query(gid); break;

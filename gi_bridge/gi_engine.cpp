@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 
 #include "gi_bridge/detail/gi_engine.h"
+#include "ldc/detail/vec_text.h"
 
 namespace ldc {
 
@@ -52,8 +54,7 @@ glm::vec3 SkyLight::radiance(const glm::vec3& w) const {
 
 namespace {
 bool finite_nonneg(const glm::vec3& v) {
-  return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z) && v.x >= 0.0f && v.y >= 0.0f &&
-         v.z >= 0.0f;
+  return detail::is_finite(glm::dvec3(v)) && glm::all(glm::greaterThanEqual(v, glm::vec3(0.0f)));
 }
 Status bad(const std::string& what) { return Status(ErrorCode::kInvalidArgument, what); }
 }  // namespace
@@ -73,8 +74,7 @@ Status check_gi_lights(const GiLights& lights) {
                std::to_string(kGiMaxPointLights));
   for (size_t i = 0; i < lights.points.size(); ++i) {
     const PointLight& p = lights.points[i];
-    if (!finite_nonneg(p.intensity) || !std::isfinite(p.position.x) || !std::isfinite(p.position.y) ||
-        !std::isfinite(p.position.z))
+    if (!finite_nonneg(p.intensity) || !detail::is_finite(glm::dvec3(p.position)))
       return bad("point light " + std::to_string(i) + ": position must be finite and intensity finite and >= 0");
   }
   return {};
@@ -163,6 +163,11 @@ Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& light
   out.n = cascades.resolution();
   out.k = cascades.levels();
   if (out.k > kGiMaxLevels) return bad("cascades of " + std::to_string(out.k) + " levels: at most 16");
+  // The kernels index voxel * 16 + direction in 32-bit ints.
+  if (size_t(out.k) * size_t(out.n) * size_t(out.n) * size_t(out.n) * 16 > size_t(INT32_MAX)) {
+    return Status(ErrorCode::kTooLarge, "gi: " + std::to_string(out.k) + " levels of " + std::to_string(out.n) +
+                                            "^3 voxels are too many (at most 2^31 / 16 voxels in all)");
+  }
   out.origin = cascades.origin();
   fill_params(cascades, lights, config, out);
   PackedGBuffer packed;
@@ -209,7 +214,7 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
     if (c == 0) continue;
     if (Status s = commit(first, c); !s.ok()) return s;
     if (config_.precombined) {
-      if (Status s = run(GiKernel::kPrecombine, first, c * 16, l); !s.ok()) return s;
+      if (Status s = run(GiKernel::kPrecombine, first * 16, c * 16, l); !s.ok()) return s;
     }
   }
   t.levels_updated = int(levels.size());

@@ -217,6 +217,7 @@ void VulkanGi::free_buffer(Buffer& b) {
 Status VulkanGi::make_buffer(int binding, VkDeviceSize size, const void* data) {
   Buffer& b = buffers_[binding];
   free_buffer(b);
+  const VkDeviceSize bytes = size;  // of `data`; the buffer is at least 16
   size = std::max<VkDeviceSize>(size, 16);
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = size;
@@ -238,11 +239,12 @@ Status VulkanGi::make_buffer(int binding, VkDeviceSize size, const void* data) {
   mai.memoryTypeIndex = type;
   if (VkResult r = vkAllocateMemory(device_, &mai, nullptr, &b.memory); r != VK_SUCCESS)
     return vk_error("vkAllocateMemory", r);
-  vkBindBufferMemory(device_, b.buffer, b.memory, 0);
+  if (VkResult r = vkBindBufferMemory(device_, b.buffer, b.memory, 0); r != VK_SUCCESS)
+    return vk_error("vkBindBufferMemory", r);
   if (VkResult r = vkMapMemory(device_, b.memory, 0, size, 0, &b.mapped); r != VK_SUCCESS) return vk_error("vkMapMemory", r);
   b.size = size;
-  if (data) std::memcpy(b.mapped, data, size_t(size));
-  else std::memset(b.mapped, 0, size_t(size));
+  std::memset(b.mapped, 0, size_t(size));
+  if (data) std::memcpy(b.mapped, data, size_t(bytes));
   return {};
 }
 
@@ -292,26 +294,20 @@ Status VulkanGi::run(GiKernel kernel, int first, int count, int level) {
   vkBeginCommandBuffer(cmd_, &begin);
   vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[int(kernel) - 1]);
   vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
-  // Only the alpha kernel takes its offset from pc.first per item; the others
-  // are dispatched whole (their counts stay far below the dispatch limit).
+  // Items pc.first .. + pc.count per dispatch, as many dispatches as the
+  // group-count limit needs.
   const int per_dispatch = kGroup * kMaxGroups;
-  if (kernel == GiKernel::kAlpha) {
-    for (int done = 0; done < count; done += per_dispatch) {
-      GiPush push{first + done, std::min(per_dispatch, count - done), level, 0};
-      vkCmdPushConstants(cmd_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-      vkCmdDispatch(cmd_, uint32_t((push.count + kGroup - 1) / kGroup), 1, 1);
-    }
-  } else {
-    if (count > per_dispatch) {
-      vkEndCommandBuffer(cmd_);
-      return Status(ErrorCode::kInvalidArgument, "vulkan: " + std::to_string(count) + " items in one dispatch (at most " +
-                                                     std::to_string(per_dispatch) + ")");
-    }
-    const int items = kernel == GiKernel::kPrecombine ? count / 16 : count;
-    GiPush push{first, items, level, 0};
+  for (int done = 0; done < count; done += per_dispatch) {
+    GiPush push{first + done, std::min(per_dispatch, count - done), level, 0};
     vkCmdPushConstants(cmd_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
-    vkCmdDispatch(cmd_, uint32_t((count + kGroup - 1) / kGroup), 1, 1);
+    vkCmdDispatch(cmd_, uint32_t((push.count + kGroup - 1) / kGroup), 1, 1);
   }
+  // The host reads (memcpy) what the shaders wrote: make it visible.
+  VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+  vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
+                       nullptr, 0, nullptr);
   vkEndCommandBuffer(cmd_);
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;

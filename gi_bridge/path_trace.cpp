@@ -2,6 +2,7 @@
 #include "gi_bridge/path_trace.h"
 
 #include <cmath>
+#include <numbers>
 #include <limits>
 #include <random>
 
@@ -100,7 +101,7 @@ PathTracer::Hit PathTracer::intersect(const glm::dvec3& origin, const glm::vec3&
 namespace {
 
 // Irradiance from the point lights at x (normal n), with shadow rays.
-glm::vec3 point_light_irradiance(const PathTracer::Impl& im, const glm::dvec3& x, const glm::vec3& n, double offset) {
+glm::vec3 point_light_irradiance(const PathTracer::Impl& im, const glm::dvec3& x, const glm::vec3& n) {
   glm::vec3 e(0.0f);
   for (const PointLight& l : im.lights.points) {
     const glm::dvec3 to = l.position - x;
@@ -111,8 +112,7 @@ glm::vec3 point_light_irradiance(const PathTracer::Impl& im, const glm::dvec3& x
     if (c <= 0.0f) continue;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    const glm::dvec3 o = x + offset * glm::dvec3(n);
-    RTCRay ray = make_ray(o, w, float(glm::length(l.position - o))).ray;
+    RTCRay ray = make_ray(x, w, float(r)).ray;
     rtcOccluded1(im.scene, &ctx, &ray);
     if (ray.tfar < 0.0f) continue;  // occluded
     e += l.intensity * (c / float(r * r));
@@ -151,12 +151,12 @@ Status PathTracer::irradiance(std::span<const glm::dvec3> points, std::span<cons
         beta *= m.albedo;
         p = p + h.distance * glm::dvec3(w) + config.ray_offset * glm::dvec3(h.normal);
         n = h.normal;
-        l += beta * point_light_irradiance(im, p, n, 0.0) * (1.0f / 3.14159265f);
+        l += beta * point_light_irradiance(im, p, n) * (1.0f / std::numbers::pi_v<float>);
         if (beta.x + beta.y + beta.z <= 0.0f) break;
       }
       sum += l;
     }
-    out[q] = sum * (3.14159265f / float(config.samples)) + point_light_irradiance(im, p0, n0, 0.0);
+    out[q] = sum * (std::numbers::pi_v<float> / float(config.samples)) + point_light_irradiance(im, p0, n0);
   });
   return {};
 }

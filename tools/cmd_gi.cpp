@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <memory>
 #include <sstream>
 #include <vector>
@@ -99,7 +100,7 @@ Status gi_image(const World& world, const Camera& cam, GiEngine& gi, const Mater
   if (Status s = gi.irradiance(p, nrm, bounces, e); !s.ok()) return s;
   for (size_t k = 0; k < pix.size(); ++k) {
     const VoxelMaterial& m = mats[hits[pix[k]].material];
-    out[pix[k]] = m.albedo * e[k] * (1.0f / 3.14159265f) + m.emission;
+    out[pix[k]] = m.albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + m.emission;
   }
   return {};
 }
@@ -138,7 +139,7 @@ Status reference_image(const World& world, const Camera& cam, const MaterialTabl
   pc.samples = samples;
   if (Status s = pt.value()->irradiance(p, nrm, bounces, e, pc); !s.ok()) return s;
   for (size_t k = 0; k < pix.size(); ++k)
-    out[pix[k]] = mats[mat[k]].albedo * e[k] * (1.0f / 3.14159265f) + mats[mat[k]].emission;
+    out[pix[k]] = mats[mat[k]].albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + mats[mat[k]].emission;
   return {};
 }
 #endif

@@ -56,7 +56,7 @@ void qout_store(int i, vec4 v) { qout_buf.v[i] = v; }
 void main() {
   int gid = int(gl_GlobalInvocationID.x);
 #if GI_KERNEL == 1
-  kernel_alpha(pc.first + gid);
+  kernel_alpha(gid);
 #elif GI_KERNEL == 2
   kernel_precombine(gid);
 #elif GI_KERNEL == 3

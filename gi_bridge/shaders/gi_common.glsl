@@ -223,20 +223,22 @@ vec3 face_axis_normal(int f) {
   return n;
 }
 
-// Kernel 1: precombined opacity of every voxel along every direction (once per upload).
+// Every kernel runs items pc.first .. pc.first + pc.count - 1, one per
+// invocation (gid counts from 0 in each dispatch).
+
+// Kernel 1: precombined opacity along every direction, item = voxel * 16 + direction (once per upload).
 void kernel_alpha(int gid) {
-  int total = gi_k() * gi_n() * gi_n() * gi_n() * 16;
-  if (gid >= total) return;
-  int voxel = gid / 16;
-  int dir = gid % 16;
-  alpha_store(gid, blend_alpha(voxel, XYZ(P.dirs[dir])));
+  if (gid >= pc.count) return;
+  int item = pc.first + gid;
+  alpha_store(item, blend_alpha(item / 16, XYZ(P.dirs[item % 16])));
 }
 
-// Kernel 2: precombined light of surface voxels pc.first .. + pc.count along every direction.
+// Kernel 2: precombined light along every direction, item = surface voxel * 16 + direction.
 void kernel_precombine(int gid) {
-  if (gid >= pc.count * 16) return;
-  int s = pc.first + gid / 16;
-  int dir = gid % 16;
+  if (gid >= pc.count) return;
+  int item = pc.first + gid;
+  int s = item / 16;
+  int dir = item % 16;
   ivec4 sp = surf_pos_load(s);
   int voxel = voxel_index(sp.w, IXYZ(sp));
   vec3 d = XYZ(P.dirs[dir]);
