@@ -163,6 +163,8 @@ bool NavSearch::expand_one(const NavData& data, int max_nodes) {
     nodes.parent[m] = n;
     nodes.via[m] = r.first_portal + k;
     nodes.position[m] = at;
+    // Detour's H_SCALE: a hair under 1 keeps the heuristic admissible despite
+    // the float rounding of the costs.
     nodes.push(m, g + 0.999f * h);
     if (h < best_distance) {
       best = m;
@@ -272,11 +274,11 @@ struct GridFloor {
 std::optional<GridFloor> floor_at(const NavData& data, const glm::ivec2& col, uint8_t level) {
   if (level == kNoLink) return std::nullopt;
   int slot = 0;
-  const int ray = data.column_first(col, &slot);
+  const int ray = data.column_in_tile(col, &slot);
   if (ray < 0) return std::nullopt;
   const NavTile& t = data.tiles[size_t(slot)];
   const uint32_t i = t.column_first[size_t(ray)] + level;
-  if (i >= t.column_first[size_t(ray) + 1] || !t.floors[i].kept) return std::nullopt;
+  if (i >= t.column_first[size_t(ray) + 1] || !t.floors[i].kept()) return std::nullopt;
   return GridFloor{uint32_t(slot), i};
 }
 
@@ -296,7 +298,7 @@ NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& 
   nodes.reset(data.dense_floor_count);
   const GridFloor s{uint32_t(start.tile), start.floor}, t{uint32_t(goal.tile), goal.floor};
   const uint32_t sn = dense_floor(data, s), tn = dense_floor(data, t);
-  const glm::dvec3 target(glm::round(glm::dvec2(goal.point)), floor_of(data, t).height);
+  const glm::dvec3 target(glm::dvec2(goal.column), floor_of(data, t).height);
   auto column_point = [&](const GridFloor& g, const glm::ivec2& col) {
     return glm::dvec3(col.x, col.y, floor_of(data, g).height);
   };
@@ -309,7 +311,7 @@ NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& 
   };
   visit(sn, s);
   nodes.cost[sn] = 0.0f;
-  nodes.position[sn] = glm::vec3(glm::dvec3(glm::round(glm::dvec2(start.point)), floor_of(data, s).height));
+  nodes.position[sn] = glm::vec3(glm::dvec2(start.column), floor_of(data, s).height);
   nodes.push(sn, float(glm::length(target - glm::dvec3(nodes.position[sn]))));
   uint32_t best = sn;
   double best_h = glm::length(target - glm::dvec3(nodes.position[sn]));

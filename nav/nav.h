@@ -71,7 +71,8 @@ Status check_nav_config(const NavConfig& config, const World& world);
 
 struct NavStats {
   size_t tiles = 0;            // tiles holding walkable floors
-  size_t floors = 0;           // floors that passed slope and clearance
+  size_t floors = 0;           // floors with room for the agent
+  size_t dropped_floors = 0;   // floors left out: over 254 in a column or 65,000 in a tile
   size_t walkable = 0;         // floors left after erosion
   size_t regions = 0;          // rectangles
   size_t portals = 0;          // directed portals
@@ -151,9 +152,8 @@ class NavQuery {
   NavQuery& operator=(const NavQuery&) = delete;
 
   // The nearest walkable floor within the half extents of p (the up axis
-  // component is the vertical reach). Error kInvalidArgument for non-finite
-  // input, kUnsupported... no: kInvalidArgument "no walkable floor within ..."
-  // when there is none.
+  // component is the vertical reach). kInvalidArgument for non-finite input
+  // or extents <= 0, and "no walkable floor within ..." when there is none.
   Result<NavPoint> nearest_walkable(const glm::dvec3& p, const glm::dvec3& half_extents) const;
 
   // The whole search in one call: begin_path + step until done + finish_path.

@@ -1,6 +1,5 @@
 // NavMesh: builds every tile, and rebuilds only what an edit reached.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <set>
 #include <sstream>
@@ -33,15 +32,14 @@ void for_tiles(NavData& data, const std::vector<int>& slots, Fn fn) {
   tbb::parallel_for(size_t(0), slots.size(), one);
 }
 
-// Slots of the listed tiles and their neighbours within `reach` tiles (8-way
-// when diagonal), sorted and unique.
-std::vector<int> with_neighbours(const NavData& data, const std::vector<int>& slots, bool diagonal) {
+// Slots of the listed tiles and their four side neighbours, sorted and unique.
+std::vector<int> with_side_neighbours(const NavData& data, const std::vector<int>& slots) {
   std::set<int> out;
   for (int s : slots) {
     const glm::ivec2 t = data.tiles[size_t(s)].coord;
     for (int dy = -1; dy <= 1; ++dy) {
       for (int dx = -1; dx <= 1; ++dx) {
-        if (!diagonal && dx != 0 && dy != 0) continue;
+        if (dx != 0 && dy != 0) continue;
         const glm::ivec2 n = t + glm::ivec2(dx, dy);
         if (data.contains_tile(n)) out.insert(data.tile_slot(n));
       }
@@ -107,7 +105,7 @@ Result<NavMesh> NavMesh::build(const World& world, const NavConfig& config, Cont
 }
 
 Result<NavUpdateStats> NavMesh::update(const World& world, std::span<const DirtyChunk> dirty) {
-  const auto start = std::chrono::steady_clock::now();
+  const ScopedTimer timer(nullptr, "");
   NavUpdateStats stats;
   NavData& data = *data_;
   const bool same_box = world.chunk_origin() == data.world_chunk_origin &&
@@ -139,15 +137,13 @@ Result<NavUpdateStats> NavMesh::update(const World& world, std::span<const Dirty
       }
     }
     const std::vector<int> extract(extract_set.begin(), extract_set.end());
-    cover_set.insert(extract.begin(), extract.end());
     const std::vector<int> cover(cover_set.begin(), cover_set.end());
     for_tiles(data, extract, [&](NavTile& t) { detail::extract_tile(data, world, t); });
-    link_to_relabel(data, with_neighbours(data, extract, false), cover,
-                    with_neighbours(data, cover, false));
+    link_to_relabel(data, with_side_neighbours(data, extract), cover, with_side_neighbours(data, cover));
     stats.dirty_tiles = extract.size();
     stats.recovered_tiles = cover.size();
   }
-  stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  stats.seconds = timer.seconds();
   return stats;
 }
 
@@ -156,11 +152,12 @@ NavStats NavMesh::stats() const {
   s.memory_bytes = sizeof(NavData) + data_->dense_tile.capacity() * sizeof(uint32_t);
   for (const NavTile& t : data_->tiles) {
     s.memory_bytes += t.memory_bytes();
+    s.dropped_floors += t.dropped_floors;
     if (t.empty()) continue;
     ++s.tiles;
     s.floors += t.floors.size();
     s.walkable += size_t(std::count_if(t.floors.begin(), t.floors.end(),
-                                       [](const detail::NavFloor& f) { return f.kept; }));
+                                       [](const detail::NavFloor& f) { return f.kept(); }));
     s.regions += t.regions.size();
     s.portals += t.portals.size();
   }

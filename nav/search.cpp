@@ -1,9 +1,9 @@
-// NavQuery: nearest walkable floor, A* over rectangles with a node budget
-// (in slices), string pulling, and the plain grid A* baseline.
+// NavQuery: input checks, snapping to the nearest walkable floor, the island
+// check and the sliced search's entry points (the searches themselves and
+// string pulling are in astar.cpp).
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 
 #include "ldc/detail/vec_text.h"
 #include "nav/detail/nav_data.h"
@@ -40,16 +40,16 @@ std::optional<FloorHit> nearest_floor(const NavData& data, const glm::dvec3& q,
                            std::clamp(q.y, col.y - 0.5, col.y + 0.5));
         if (std::abs(p.x - q.x) > reach.x || std::abs(p.y - q.y) > reach.y) continue;
         int slot = 0;
-        const int index = data.column_first(col, &slot);
+        const int index = data.column_in_tile(col, &slot);
         if (index < 0) continue;
         const NavTile& t = data.tiles[size_t(slot)];
         for (uint32_t i = t.column_first[size_t(index)]; i < t.column_first[size_t(index) + 1]; ++i) {
           const NavFloor& f = t.floors[i];
-          if (!f.kept || f.region == kNoRegion) continue;
+          if (!f.kept()) continue;
           if (std::abs(f.height - q.z) > reach.z) continue;
           const glm::dvec3 at(p, f.height);
           const double d = glm::length(at - q);
-          if (!best || d < best->distance) best = FloorHit{slot, i, at, d};
+          if (!best || d < best->distance) best = FloorHit{slot, i, col, at, d};
         }
       }
     }

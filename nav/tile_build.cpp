@@ -15,7 +15,7 @@ size_t NavTile::memory_bytes() const {
          portals.capacity() * sizeof(NavPortal);
 }
 
-int NavData::column_first(const glm::ivec2& col, int* slot_out) const {
+int NavData::column_in_tile(const glm::ivec2& col, int* slot_out) const {
   const glm::ivec2 tile = tile_of_column(col);
   if (!contains_tile(tile)) return -1;
   const int slot = tile_slot(tile);
@@ -28,7 +28,7 @@ int NavData::column_first(const glm::ivec2& col, int* slot_out) const {
 
 std::span<const NavFloor> NavData::column(const glm::ivec2& col) const {
   int slot = 0;
-  const int index = column_first(col, &slot);
+  const int index = column_in_tile(col, &slot);
   if (index < 0) return {};
   const NavTile& t = tiles[size_t(slot)];
   return {t.floors.data() + t.column_first[size_t(index)],
@@ -52,6 +52,7 @@ void setup_nav_data(NavData& data, const World& world, const NavConfig& config) 
   data.config = config;
   data.lattice = world.lattice();
   data.chunk_size = world.chunk_size();
+  data.chunk_shift = world.chunk_shift();
   data.up = config.up_axis;
   data.axis_u = axis_u(config.up_axis);
   data.axis_v = axis_v(config.up_axis);
@@ -98,6 +99,7 @@ void extract_tile(const NavData& data, const World& world, NavTile& tile) {
   tile.regions.clear();
   tile.portals.clear();
   tile.column_first.clear();
+  tile.dropped_floors = 0;
   const int c = data.chunk_size;
   const std::vector<const Chunk*> stack = tile_stack(data, world, tile.coord);
   if (std::all_of(stack.begin(), stack.end(), [](const Chunk* ch) { return ch == nullptr; })) {
@@ -120,13 +122,15 @@ void extract_tile(const NavData& data, const World& world, NavTile& tile) {
           open_floor = false;
           continue;
         }
-        if (tile.floors.size() - column_start >= size_t(kMaxLevels)) continue;
-        if (tile.floors.size() >= kMaxTileFloors) continue;
+        if (tile.floors.size() - column_start >= size_t(kMaxLevels) ||
+            tile.floors.size() >= kMaxTileFloors) {
+          ++tile.dropped_floors;
+          continue;
+        }
         NavFloor f;
         f.height = float(depth);
         f.ceiling = std::numeric_limits<float>::infinity();
-        const glm::vec3 n = decode_normal(p.normal);
-        if (n[data.up] < data.min_normal_up) f.flags |= kSteepNormal;
+        f.steep_normal = decode_normal(p.normal)[data.up] < data.min_normal_up;
         tile.floors.push_back(f);
         open_floor = true;
       }
@@ -171,9 +175,9 @@ uint8_t best_link(const NavData& data, const NavFloor& f, std::span<const NavFlo
 // whose point normals are steep are stepped over; a steep ramp or cliff
 // stays closed beyond its first cell.
 bool slope_walkable(const NavFloor& f, const std::array<const NavFloor*, 4>& side) {
-  if (!(f.flags & kSteepNormal)) return true;
+  if (!f.steep_normal) return true;
   for (const NavFloor* g : side) {
-    if (g && !(g->flags & kSteepNormal)) return true;
+    if (g && !g->steep_normal) return true;
   }
   return false;
 }
@@ -187,16 +191,20 @@ void link_tile(const NavData& data, NavTile& tile) {
   for (int lv = 0; lv < c; ++lv) {
     for (int lu = 0; lu < c; ++lu) {
       const int ray = lv * c + lu;
+      const std::span<const NavFloor> own = data.column(base + glm::ivec2(lu, lv));
       for (uint32_t i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
         NavFloor& f = tile.floors[i];
         std::array<const NavFloor*, 4> side{};
+        const uint32_t level = i - tile.column_first[size_t(ray)];
         for (int d = 0; d < 4; ++d) {
           std::span<const NavFloor> col = data.column(base + glm::ivec2(lu, lv) + kDirStep[d]);
-          f.link[d] = best_link(data, f, col);
-          if (f.link[d] != kNoLink) side[size_t(d)] = &col[f.link[d]];
+          const uint8_t j = best_link(data, f, col);
+          // Both ways or not at all: the neighbour's best floor back must be this one.
+          const bool mutual = j != kNoLink && best_link(data, col[j], own) == level;
+          f.link[d] = mutual ? j : kNoLink;
+          if (mutual) side[size_t(d)] = &col[j];
         }
-        f.flags &= uint8_t(~kWalkable);
-        if (slope_walkable(f, side)) f.flags |= kWalkable;
+        f.walkable = slope_walkable(f, side);
       }
     }
   }
@@ -251,7 +259,7 @@ void erode_tile(const NavData& data, NavTile& tile) {
   if (tile.empty()) return;
   const int limit = 2 * data.erode_cells;
   if (limit == 0) {
-    for (NavFloor& f : tile.floors) f.kept = f.flags & kWalkable;
+    for (NavFloor& f : tile.floors) f.region = f.walkable ? kUnassigned : kNoRegion;
     return;
   }
   const ErosionWindow w = make_window(data, tile);
@@ -268,20 +276,20 @@ void erode_tile(const NavData& data, NavTile& tile) {
     const int side = w.column_index(at);
     if (side < 0) {  // beyond the window: only its linked-ness matters (it is not updated)
       const std::span<const NavFloor> c = data.column(at);
-      return {(c[f.link[s]].flags & kWalkable) ? -2 : -1, f.link[s]};
+      return {c[f.link[s]].walkable ? -2 : -1, f.link[s]};
     }
-    if (!(floor_at(side, f.link[s]).flags & kWalkable)) return {-1, 0};
+    if (!floor_at(side, f.link[s]).walkable) return {-1, 0};
     return {side, f.link[s]};
   };
   for (int col = 0; col < w.size * w.size; ++col) {
     const uint32_t n = w.first[size_t(col) + 1] - w.first[size_t(col)];
     for (uint32_t k = 0; k < n; ++k) {
       const NavFloor& f = floor_at(col, int(k));
-      bool border = !(f.flags & kWalkable);  // not a node: 0, never queued below
+      bool border = !f.walkable;  // not a node: 0, never queued below
       for (int s = 0; s < 4 && !border; ++s) border = walkable_side(col, f, s).first == -1;
       if (!border) continue;
       dist[w.first[size_t(col)] + k] = 0;
-      if (f.flags & kWalkable) buckets[0].push_back(pack(col, int(k)));
+      if (f.walkable) buckets[0].push_back(pack(col, int(k)));
     }
   }
   auto relax = [&](int col, int floor, int d) {
@@ -316,7 +324,8 @@ void erode_tile(const NavData& data, NavTile& tile) {
       const int col = (own.y + lv) * w.size + own.x + lu;
       for (uint32_t i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
         const uint32_t k = i - tile.column_first[size_t(ray)];
-        tile.floors[i].kept = (tile.floors[i].flags & kWalkable) && dist[w.first[size_t(col)] + k] >= limit;
+        NavFloor& f = tile.floors[i];
+        f.region = f.walkable && dist[w.first[size_t(col)] + k] >= limit ? kUnassigned : kNoRegion;
       }
     }
   }
@@ -337,19 +346,14 @@ struct TileFloors {
     const int i = tile.column_first[size_t(ray)] + level;
     return i < tile.column_first[size_t(ray) + 1] ? i : -1;
   }
-  int level_of(int lu, int lv, int index) const {
-    return index - tile.column_first[size_t(lv * data.chunk_size + lu)];
-  }
-  // The free kept floor linked (both ways) from floor i at (lu, lv) in direction d, or -1.
+  // The kept, unassigned floor linked from floor i at (lu, lv) in direction d, or -1.
   int free_neighbour(int lu, int lv, int i, int d) const {
     const NavFloor& f = tile.floors[size_t(i)];
     const int nu = lu + kDirStep[d].x, nv = lv + kDirStep[d].y;
     const int j = at(nu, nv, f.link[d]);
     if (j < 0) return -1;
     const NavFloor& g = tile.floors[size_t(j)];
-    if (!g.kept || g.region != kNoRegion) return -1;
-    if (g.link[opposite(d)] != level_of(lu, lv, i)) return -1;
-    return j;
+    return g.region == kUnassigned ? j : -1;
   }
 };
 
@@ -359,7 +363,6 @@ void cover_tile(const NavData& data, NavTile& tile) {
   tile.regions.clear();
   tile.portals.clear();
   if (tile.empty()) return;
-  for (NavFloor& f : tile.floors) f.region = kNoRegion;
   const int c = data.chunk_size;
   const TileFloors tf{data, tile};
   const glm::ivec2 base = tile.coord * c;
@@ -368,7 +371,7 @@ void cover_tile(const NavData& data, NavTile& tile) {
     for (int lu = 0; lu < c; ++lu) {
       const int ray = lv * c + lu;
       for (int i = tile.column_first[size_t(ray)]; i < tile.column_first[size_t(ray) + 1]; ++i) {
-        if (!tile.floors[size_t(i)].kept || tile.floors[size_t(i)].region != kNoRegion) continue;
+        if (tile.floors[size_t(i)].region != kUnassigned) continue;
         const uint16_t id = uint16_t(tile.regions.size());
         // Grow along +u.
         row.assign(1, i);
@@ -389,7 +392,6 @@ void cover_tile(const NavData& data, NavTile& tile) {
             if (k > 0) {  // the new row's floors must be linked to each other
               const NavFloor& prev = tile.floors[size_t(next.back())];
               if (tf.at(lu + int(k), v + 1, prev.link[0]) != j) break;
-              if (tile.floors[size_t(j)].link[2] != tf.level_of(lu + int(k) - 1, v + 1, next.back())) break;
             }
             next.push_back(j);
           }
@@ -425,7 +427,7 @@ namespace {
 // The floor of region `id` in a column of its rectangle.
 const NavFloor* region_floor(const NavData& data, const glm::ivec2& col, uint16_t id) {
   for (const NavFloor& f : data.column(col)) {
-    if (f.region == id && f.kept) return &f;
+    if (f.region == id) return &f;
   }
   return nullptr;
 }
@@ -474,14 +476,14 @@ void connect_tile(const NavData& data, NavTile& tile) {
         const NavFloor* f = region_floor(data, col, id);
         const glm::ivec2 other = col + kDirStep[d];
         int other_slot = 0;
-        const int other_index = f ? data.column_first(other, &other_slot) : -1;
+        const int other_index = f ? data.column_in_tile(other, &other_slot) : -1;
         const NavFloor* g = nullptr;
         if (other_index >= 0 && f->link[d] != kNoLink) {
           const NavTile& ot = data.tiles[size_t(other_slot)];
           const uint32_t gi = ot.column_first[size_t(other_index)] + f->link[d];
           if (gi < ot.column_first[size_t(other_index) + 1]) g = &ot.floors[gi];
         }
-        if (!g || !g->kept || g->region == kNoRegion) {
+        if (!g || !g->kept()) {
           close();
           continue;
         }

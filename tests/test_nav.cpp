@@ -122,6 +122,21 @@ TEST(Nav, MazeShortestLengthIsKnown) {
   EXPECT_LE(grid->length, exact * 1.12);
 }
 
+// A start snapped to the far edge of a column's square (which rounds to the
+// next column) still starts the grid search on that column.
+TEST(Nav, GridBaselineStartsOnTheSnappedColumn) {
+  const World world = boxes_world({floor_slab(0, 0, 8, 4)});
+  NavConfig config;
+  config.agent_radius = 0.0;
+  const NavMesh nav = nav_of(world, config);
+  NavQuery query(nav, 1 << 16);
+  Result<NavPath> path = query.find_grid_path({9, 2, 1}, {4, 2, 1});
+  ASSERT_TRUE(path.ok()) << path.status().to_string();
+  EXPECT_EQ(path->status, PathStatus::kComplete);
+  EXPECT_NEAR(path->corners.front().x, 7.8, 1e-6);
+  EXPECT_NEAR(path->length, 3.8, 1e-6);
+}
+
 // The same wall with the default radius: the path keeps about 0.6 m from it;
 // its length is that of the path round the wall grown by a disc of 0.6 m.
 TEST(Nav, MazeWithAgentRadiusKeepsClear) {

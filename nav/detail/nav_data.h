@@ -16,28 +16,32 @@
 namespace ldc::detail {
 
 inline constexpr uint8_t kNoLink = 0xFF;
-inline constexpr uint16_t kNoRegion = 0xFFFF;
+inline constexpr uint16_t kNoRegion = 0xFFFF;       // not walkable, or eroded away
+inline constexpr uint16_t kUnassigned = 0xFFFE;     // kept by erosion, not yet in a rectangle
 inline constexpr int kMaxLevels = 254;  // floors per column kept (link indices are bytes)
-// Floors per tile kept (16-bit offsets and region ids); only a tile of
-// 32 x 32 columns with over 60 walkable levels each reaches it.
+// Floors per tile kept (16-bit offsets and region ids): 63 floors in every
+// column of a 32 x 32 tile, 15 at C = 64. Floors beyond it are dropped and
+// counted (NavStats::dropped_floors).
 inline constexpr size_t kMaxTileFloors = 65000;
 
 // Directions in the ground plane: 0 +u, 1 +v, 2 -u, 3 -v.
 inline constexpr glm::ivec2 kDirStep[4] = {{1, 0}, {0, 1}, {-1, 0}, {0, -1}};
 inline constexpr int opposite(int dir) { return (dir + 2) & 3; }
 
-inline constexpr uint8_t kSteepNormal = 1;  // the stored normal is steeper than max_slope
-inline constexpr uint8_t kWalkable = 2;     // the slope over the neighbours is within max_slope
-
-// One floor: the top of a solid span with enough room above. Whether its
-// slope is walkable is decided once its neighbours are linked (kWalkable).
+// One floor: the top of a solid span with enough room above. Each building
+// phase writes only its own tile's fields and reads its neighbours' fields
+// that earlier phases wrote, so tiles build in parallel without races:
+// extraction sets steep_normal, linking sets link and walkable, erosion
+// sets region to kUnassigned (kept) or kNoRegion, covering sets region.
 struct NavFloor {
   float height = 0.0f;   // depth of the floor along up [Units: cells]
   float ceiling = 0.0f;  // depth of the next solid above, or +inf
-  uint8_t link[4] = {kNoLink, kNoLink, kNoLink, kNoLink};  // floor index in the neighbour column
-  bool kept = false;     // walkable and survived erosion
-  uint8_t flags = 0;     // kSteepNormal, kWalkable
+  uint8_t link[4] = {kNoLink, kNoLink, kNoLink, kNoLink};  // floor index in the neighbour column (both ways)
+  bool steep_normal = false;  // the stored normal is steeper than max_slope
+  bool walkable = false;      // slope walkable (its normal or a linked neighbour's)
   uint16_t region = kNoRegion;  // rectangle (local to the tile) holding it
+
+  bool kept() const { return region != kNoRegion; }  // walkable and survived erosion
 };
 
 // A rectangle of columns [lo, hi] (inclusive, global) whose floors are linked.
@@ -72,6 +76,7 @@ struct NavTile {
   std::vector<NavPortal> portals;      // grouped by region
   uint32_t dense_first = 0;            // first dense region index (for searches)
   uint32_t dense_floor_first = 0;      // first dense floor index (for grid searches)
+  uint32_t dropped_floors = 0;         // floors beyond kMaxTileFloors, left out
 
   bool empty() const { return floors.empty(); }
   size_t memory_bytes() const;
@@ -82,6 +87,7 @@ struct NavData {
   Lattice lattice;
   int chunk_size = 32;
   int up = 2, axis_u = 0, axis_v = 1;  // lattice axes
+  int chunk_shift = 5;                 // log2(chunk_size)
   glm::ivec2 tile_origin{0};           // first tile (chunk coordinates on u, v)
   glm::ivec2 tile_dims{0};
   glm::ivec3 world_chunk_origin{0};    // box the mesh was built for
@@ -106,12 +112,13 @@ struct NavData {
     return t.x >= 0 && t.y >= 0 && t.x < tile_dims.x && t.y < tile_dims.y;
   }
   glm::ivec2 tile_of_column(const glm::ivec2& column) const {
-    const int shift = std::countr_zero(static_cast<unsigned>(chunk_size));
-    return {column.x >> shift, column.y >> shift};
+    return {column.x >> chunk_shift, column.y >> chunk_shift};
   }
   // Floors of a global column; empty when outside the mesh or floorless.
   std::span<const NavFloor> column(const glm::ivec2& column) const;
-  int column_first(const glm::ivec2& column, int* tile_slot_out) const;
+  // The column's index in its tile (its vertical ray), and the tile slot;
+  // -1 when outside the mesh or in a floorless tile.
+  int column_in_tile(const glm::ivec2& column, int* tile_slot_out) const;
 
   // Lattice (u, v, up) of a world position, and back.
   glm::dvec3 to_nav(const glm::dvec3& world) const;
@@ -130,8 +137,9 @@ void setup_nav_data(NavData& data, const World& world, const NavConfig& config);
 // Floors of one tile from the world's vertical rays; links within the tile
 // and to the neighbours' floors are left for link_tile().
 void extract_tile(const NavData& data, const World& world, NavTile& tile);
-// Links every floor of the tile to its neighbour columns' floors (neighbour
-// tiles must be extracted) and decides whether its slope is walkable: by its
+// Links every floor of the tile to its neighbour columns' floors, both ways
+// (a link holds only when each floor is the other's best: neighbour tiles
+// must be extracted), and decides whether its slope is walkable: by its
 // stored normal, or by a linked neighbour's (see slope_walkable). Point
 // normals see every ripple finer than a cell: on the default landscape, thin
 // creases of steep normals alone split the walkable ground into many more

@@ -15,7 +15,8 @@ namespace ldc::detail {
 struct FloorHit {
   int tile = 0;          // tile slot
   uint32_t floor = 0;    // index in the tile's floors
-  glm::dvec3 point{0.0};
+  glm::ivec2 column{0};  // the floor's column
+  glm::dvec3 point{0.0};  // in the column's square (its edge may round to the next column)
   double distance = 0.0;
 };
 
