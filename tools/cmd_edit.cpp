@@ -1,5 +1,4 @@
 // ldc edit: a world plus a JSON script of brush edits -> the edited world.
-#include <cctype>
 #include <cstdio>
 #include <memory>
 
@@ -37,12 +36,6 @@ struct LiveMesh {
   }
 };
 
-bool has_ldc_extension(const std::string& path) {
-  if (path.size() < 4) return false;
-  std::string ext = path.substr(path.size() - 4);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".ldc";
-}
 
 nlohmann::json edit_json(size_t index, const ScriptEdit& e) {
   return {{"index", index}, {"op", edit_op_name(e.edit.op)}, {"brush", e.brush_name}};

@@ -3,7 +3,6 @@
 #include <memory>
 
 #include "common.h"
-#include "ldc/detail/vec_text.h"
 #include "ldc/io.h"
 #include "nav/nav.h"
 
@@ -15,7 +14,8 @@ built into an LDC at the navigation cell size (--cell-size). The up axis default
 .ldc worlds (the built-in landscape is z up) and to y for meshes (the Recast convention).
 Output (stdout, or -o FILE), drawable with `ldc render --overlay FILE`:
   {"status": "complete" | "unreachable" | "out_of_nodes", "length": metres,
-   "path": [[x,y,z], ...], "start": [x,y,z], "goal": [x,y,z], "points": [start, goal],
+   "path": [[x,y,z], ...], "start": [x,y,z] (the start snapped to its floor), "end": [x,y,z]
+   (the goal's floor, or where a partial path stops), "points": [start, end],
    "regions", "nodes_searched",
    "nav": {"floors", "walkable", "regions", "components", "memory_bytes", "build_seconds"},
    "query_seconds"}
@@ -33,12 +33,8 @@ struct PathArgs {
   NavConfig agent;
 };
 
-bool is_ldc_file(const std::string& path) {
-  return path.size() >= 4 && path.compare(path.size() - 4, 4, ".ldc") == 0;
-}
-
 Result<int> up_axis(const PathArgs& a) {
-  if (a.up == "auto") return is_ldc_file(a.input) ? 2 : 1;
+  if (a.up == "auto") return has_ldc_extension(a.input) ? 2 : 1;
   if (a.up == "x") return 0;
   if (a.up == "y") return 1;
   if (a.up == "z") return 2;
@@ -46,7 +42,7 @@ Result<int> up_axis(const PathArgs& a) {
 }
 
 Result<World> load_input(const PathArgs& a, Context* ctx) {
-  if (is_ldc_file(a.input)) return load_world(a.input, {}, ctx);
+  if (has_ldc_extension(a.input)) return load_world(a.input, {}, ctx);
   if (!(a.cell_size > 0.0) || !std::isfinite(a.cell_size)) {
     return Status(ErrorCode::kInvalidArgument,
                   "--cell-size " + std::to_string(a.cell_size) + ": must be a finite number > 0");
@@ -58,19 +54,17 @@ Result<World> load_input(const PathArgs& a, Context* ctx) {
   return build_from_mesh(mesh.value(), grid, ctx);
 }
 
-nlohmann::json point_json(const glm::dvec3& p) { return {p.x, p.y, p.z}; }
-
 nlohmann::json path_json(const NavPath& path, const NavMesh& nav, double build_seconds,
                          double query_seconds) {
   nlohmann::json points = nlohmann::json::array();
-  for (const glm::dvec3& p : path.corners) points.push_back(point_json(p));
+  for (const glm::dvec3& p : path.corners) points.push_back(vec_json(p));
   const NavStats s = nav.stats();
   return {{"status", path_status_name(path.status)},
           {"length", path.length},
           {"path", points},
-          {"start", point_json(path.corners.front())},
-          {"goal", point_json(path.corners.back())},
-          {"points", {point_json(path.corners.front()), point_json(path.corners.back())}},
+          {"start", vec_json(path.corners.front())},
+          {"end", vec_json(path.corners.back())},
+          {"points", {vec_json(path.corners.front()), vec_json(path.corners.back())}},
           {"regions", path.regions},
           {"nodes_searched", path.nodes_searched},
           {"nav", {{"floors", s.floors}, {"walkable", s.walkable}, {"regions", s.regions},

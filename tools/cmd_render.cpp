@@ -405,7 +405,6 @@ bool has_png_extension(const std::string& path) {
   return ext == ".png";
 }
 
-nlohmann::json vec_json(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
 
 int run_render(const RenderArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -160,5 +161,14 @@ void set_thread_count(int threads) {
 int thread_count() {
   return int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
 }
+
+bool has_ldc_extension(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".ldc";
+}
+
+nlohmann::json vec_json(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
 
 }  // namespace ldc::tool

@@ -51,6 +51,12 @@ int fail(const std::string& command, const std::string& message);
 // Infinity, which JSON cannot hold, say so).
 Result<nlohmann::json> read_json_file(const std::string& path);
 
+// Whether a path ends in .ldc (any case).
+bool has_ldc_extension(const std::string& path);
+
+// [x, y, z] for JSON output.
+nlohmann::json vec_json(const glm::dvec3& v);
+
 // "1,2,3" -> vector; false when malformed.
 bool parse_vec3(const std::string& text, glm::dvec3* out);
 
