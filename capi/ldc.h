@@ -1,9 +1,9 @@
 /* ldc.h: the C API of ldc, for engines and language bindings (C#, Rust,
  * Unity native plugins, Godot extensions) that need a plain C ABI.
  *
- * Link target: ldc::c (libldc_c.so, a shared library: FFI loaders need one,
- * and it keeps the C++ runtime, TBB and the static ldc modules behind one
- * C symbol table; only the ldc_* functions below are exported).
+ * Link target: ldc::c (libldc_c.so, a shared library: FFI loaders need one;
+ * the static ldc modules are linked in and only the ldc_* functions below
+ * are exported; it depends on libstdc++ and libtbb like any C++ library).
  *
  * Conventions
  *  - Units: metres for positions, lengths and radii; world coordinates are
@@ -24,8 +24,9 @@
  *    LDC_BUFFER_TOO_SMALL with the needed count written, and nothing else
  *    changes (ldc_world_take_dirty keeps its list).
  *  - Thread safety: calls on one handle must not overlap (a world is not
- *    thread-safe; lock around it if several threads use it). Calls on
- *    different handles may run concurrently. Heavy calls (building, meshing,
+ *    thread-safe; lock around it if several threads use it). A cascades
+ *    handle shares its world's lock: it reads the world and the world's
+ *    edits feed it. Other handles may be used concurrently. Heavy calls (building, meshing,
  *    batched ray casts, voxelizing) run in parallel internally (TBB).
  *    ldc_last_error() is per thread.
  *  - No exceptions or C++ types cross this header; out of memory is

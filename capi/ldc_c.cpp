@@ -54,7 +54,12 @@ ldc_status guarded(const char* call, Fn&& fn) {
   try {
     return fn();
   } catch (const std::bad_alloc&) {
-    return fail(LDC_TOO_LARGE, std::string(call) + ": out of memory");
+    // Building a message may itself fail for lack of memory: then the code alone.
+    try {
+      return fail(LDC_TOO_LARGE, std::string(call) + ": out of memory");
+    } catch (...) {
+      return LDC_TOO_LARGE;
+    }
   } catch (const std::exception& e) {
     return fail(LDC_INTERNAL, std::string(call) + ": " + e.what());
   } catch (...) {
@@ -114,6 +119,7 @@ struct ldc_world {
   int max_nodes = 2048;
   glm::dvec3 search_half_extents{2.0, 2.0, 4.0};
   std::optional<ldc::NavMesh> nav;
+  std::optional<ldc::NavQuery> query;  // on `nav`, kept between paths (its search arrays are reused)
   std::vector<ldc::DirtyChunk> nav_pending;
 
   std::vector<ldc_cascades*> cascades;
@@ -158,8 +164,9 @@ void ldc_world::fan_out(const std::vector<ldc::DirtyChunk>& dirty) {
     u.version = d.version;
     mark_mesh_neighbours(d);
   }
-  mesh_pending.insert(mesh_pending.end(), dirty.begin(), dirty.end());
-  nav_pending.insert(nav_pending.end(), dirty.begin(), dirty.end());
+  // Only what is built needs the list: a first build reads the world as it is.
+  if (mesh_built) mesh_pending.insert(mesh_pending.end(), dirty.begin(), dirty.end());
+  if (nav) nav_pending.insert(nav_pending.end(), dirty.begin(), dirty.end());
   for (ldc_cascades* c : cascades) c->pending.insert(c->pending.end(), dirty.begin(), dirty.end());
   queries_stale = true;
 }
@@ -516,6 +523,7 @@ ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* conf
     world->nav_config = c;
     world->max_nodes = config->max_nodes;
     world->search_half_extents = half;
+    world->query.reset();
     world->nav.reset();
     world->nav_pending.clear();
     return LDC_OK;
@@ -527,6 +535,7 @@ static ldc::Status sync_nav(ldc_world* world) {
     ldc::Result<ldc::NavMesh> nav = ldc::NavMesh::build(world->world(), world->nav_config);
     if (!nav.ok()) return nav.status();
     world->nav.emplace(std::move(nav).value());
+    world->query.emplace(*world->nav, world->max_nodes);
   } else if (!world->nav_pending.empty()) {
     ldc::Result<ldc::NavUpdateStats> r = world->nav->update(world->world(), world->nav_pending);
     if (!r.ok()) return r.status();
@@ -542,10 +551,9 @@ ldc_status ldc_world_find_path(ldc_world* world, const double from[3], const dou
     if (!from || !to) return null_argument("ldc_world_find_path", from ? "to" : "from");
     if (!info) return null_argument("ldc_world_find_path", "info");
     if (ldc_status s = from_status(sync_nav(world)); s != LDC_OK) return s;
-    ldc::NavQuery query(*world->nav, world->max_nodes);
     ldc::PathQueryOptions options;
     options.search_half_extents = world->search_half_extents;
-    ldc::Result<ldc::NavPath> path = query.find_path(vec3(from), vec3(to), options);
+    ldc::Result<ldc::NavPath> path = world->query->find_path(vec3(from), vec3(to), options);
     if (!path.ok()) {
       const bool no_floor = path.status().message().find("no walkable floor") != std::string::npos;
       return fail(no_floor ? LDC_NOT_FOUND : static_cast<ldc_status>(path.status().code()),

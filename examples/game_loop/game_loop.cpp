@@ -95,6 +95,7 @@ struct Session {
   ldc::WorldEditor editor;
   ldc::ChunkedMesh mesh;
   ldc::NavMesh nav;
+  ldc::NavQuery path_query{nav};  // kept across frames: its search arrays are reused
   ldc::Queries queries;
   glm::dvec3 player{0.0};
   glm::dvec3 agent{0.0};
@@ -171,8 +172,7 @@ Frame play_frame(Session& s, int frame) {
   if (!nav.ok()) std::fprintf(stderr, "frame %d: nav: %s\n", frame, nav.status().to_string().c_str());
 
   t = Clock::now();
-  ldc::NavQuery query(s.nav);
-  ldc::Result<ldc::NavPath> path = query.find_path(s.agent, s.goal);
+  ldc::Result<ldc::NavPath> path = s.path_query.find_path(s.agent, s.goal);
   f.path_ms = ms_since(t);
   if (path.ok()) {
     f.path_found = true;
