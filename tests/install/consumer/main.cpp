@@ -4,6 +4,7 @@
 #include "contour/contour.h"
 #include "csg/csg.h"
 #include "ldc/query.h"
+#include "ldc/build.h"
 #include "ldc/terrain.h"
 #include "ldc/version.h"
 #include "nav/nav.h"
@@ -23,6 +24,8 @@ int main() {
   ldc::VoxelConfig voxels;
   voxels.voxel_size = 0.8;
   ldc::Result<ldc::VoxelGrid> grid = ldc::voxelize(editor.world(), voxels);
+  // A missing file must fail cleanly; linking this pulls in the stb image code.
+  if (ldc::load_heightfield_png("no-such-heightfield.png", 0.5, 10.0, 1.0, 0.0).ok()) return 1;
   if (!mesh.ok() || !nav.ok() || !hit.ok() || !hit->hit || !grid.ok()) return 1;
   std::printf("consumer: ok: ldc %s, %zu triangles, %zu walkable floors, ground at z = %.2f, %zu surface voxels\n",
               LDC_VERSION_STRING, mesh->triangle_count(), nav->stats().walkable, hit->point.z,
