@@ -236,9 +236,8 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
       if (!editor.apply(ldc::Brush::sphere(at, 1.0), ldc::EditOp::kSubtract).ok()) continue;
       const std::vector<ldc::DirtyChunk> dirty = editor.take_dirty();
       const auto s = Clock::now();
-      const ldc::NavUpdateStats u = edited.update(editor.world(), dirty).value();
+      (void)edited.update(editor.world(), dirty).value();
       ours_rebuild.push_back(us_since(s) / 1000.0);
-      (void)u;
       if (!detour_tiled) continue;
       const ldc::ContourMesh mesh = ldc::contour_world(editor.world()).value();
       const Triangles all = detour_triangles(mesh.positions, mesh.triangles, scene.frame);

@@ -414,7 +414,7 @@ double detour_rebuild_tile(DetourNav& nav_, const std::vector<float>& verts, con
 namespace ldc::bench {
 
 // The nearest point of Detour's navmesh within half_extents of p, for
-// comparing walkable areas (bench_nav's diagnostics).
+// comparing walkable areas (bench/nav_coverage.cpp).
 bool detour_nearest_point(DetourNav& nav, const glm::vec3& p, const glm::vec3& half_extents,
                           glm::vec3* nearest) {
   DetourNav::Impl& impl = nav.impl();

@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   for (int y = 0; y < ht; ++y) {
     for (int x = 0; x < w; ++x) {
       const glm::dvec3 top = world.lattice().node_position({lo.x + x, lo.y + y, hi.z});
-      // Our floor: the highest walkable floor in this column's square.
+      // Our floor: the walkable floor in this column's square nearest half-way up.
       ldc::Result<ldc::NavPoint> p = query.nearest_walkable({top.x, top.y, top.z / 2}, {0.5 * h, 0.5 * h, top.z});
       const std::vector<ldc::SurfacePoint> pts = world.ray_points(2, {lo.x + x, lo.y + y});
       if (pts.empty()) continue;
@@ -52,6 +52,10 @@ int main(int argc, char** argv) {
     }
   }
   std::FILE* f = std::fopen(out.c_str(), "wb");
+  if (!f) {
+    std::fprintf(stderr, "cannot write %s\n", out.c_str());
+    return 1;
+  }
   std::fprintf(f, "P6 %d %d 255\n", w, ht);
   std::fwrite(img.data(), 1, img.size(), f);
   std::fclose(f);
