@@ -445,29 +445,51 @@ TEST(Cascades, PackedLayoutTilesFacesInXAndLevelsInY) {
   EXPECT_GT(own, 50u);
 }
 
-TEST(Objects, StaticObjectIsVoxelizedWithItsVolume) {
+// A lone object voxelized at 0.3 m over an empty landscape.
+VoxelGrid voxelize_object(const StaticObject& o) {
   World empty = build_from_primitive(Primitive{.radius = 0.1, .transform = glm::translate(glm::dmat4(1.0), glm::dvec3(-5.0))},
                                      grid_at(0.1)).value();
-  StaticObject o;
-  const glm::dvec3 lo(0.13, 0.21, 0.05), hi(1.07, 0.93, 1.61);
-  o.mesh = std::make_shared<TriangleMesh>(test::box_mesh(lo, hi));
-  o.material = 2;
   VoxelizeOptions opt;
   opt.objects = std::span<const StaticObject>(&o, 1);
   opt.box = VoxelBox{glm::ivec3(-1), glm::ivec3(8)};
   opt.faces = true;
   Result<VoxelGrid> g = voxelize(empty, VoxelConfig{.voxel_size = 0.3}, opt);
-  ASSERT_TRUE(g.ok()) << g.status().message();
-  const glm::dvec3 e = hi - lo;
-  EXPECT_NEAR(g.value().volume(), e.x * e.y * e.z, 0.01 * e.x * e.y * e.z);
+  EXPECT_TRUE(g.ok()) << g.status().message();
+  return g.ok() ? std::move(g).value() : VoxelGrid{};
+}
+
+// Every face an object's surface owns has material `id`'s albedo (and there is one).
+void expect_own_faces_of_material(const VoxelGrid& g, uint16_t id) {
   bool saw_material = false;
-  for (const VoxelFaces& s : g.value().surface_faces) {
+  for (const VoxelFaces& s : g.surface_faces) {
     if (s[0].flags == kFaceOwn) {
       saw_material = true;
-      EXPECT_LT(glm::length(glm::vec3(s[0].albedo) - default_material_table().materials[2].albedo), 1e-5f);
+      EXPECT_LT(glm::length(glm::vec3(s[0].albedo) - default_material_table().materials[id].albedo), 1e-5f);
     }
   }
   EXPECT_TRUE(saw_material);
+}
+
+TEST(Objects, StaticObjectIsVoxelizedWithItsVolume) {
+  StaticObject o;
+  const glm::dvec3 lo(0.13, 0.21, 0.05), hi(1.07, 0.93, 1.61);
+  o.mesh = std::make_shared<TriangleMesh>(test::box_mesh(lo, hi));
+  o.material = 2;
+  const VoxelGrid g = voxelize_object(o);
+  const glm::dvec3 e = hi - lo;
+  EXPECT_NEAR(g.volume(), e.x * e.y * e.z, 0.01 * e.x * e.y * e.z);
+  expect_own_faces_of_material(g, 2);
+}
+
+// A mesh with its own (named) material ids takes material_base + id.
+TEST(Objects, MeshMaterialIdsAreOffsetByMaterialBase) {
+  TriangleMesh mesh = test::box_mesh(glm::dvec3(0.13, 0.21, 0.05), glm::dvec3(1.07, 0.93, 1.61));
+  mesh.triangle_material.assign(mesh.triangles.size(), 0);
+  mesh.material_names = {"stone"};
+  StaticObject o;
+  o.mesh = std::make_shared<TriangleMesh>(std::move(mesh));
+  o.material_base = 3;
+  expect_own_faces_of_material(voxelize_object(o), 3);
 }
 
 // --- Bad input -------------------------------------------------------------------

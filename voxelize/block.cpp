@@ -6,13 +6,10 @@
 #include <cassert>
 #include <cmath>
 
+#include "ldc/detail/ray_math.h"
+
 namespace ldc::detail {
 namespace {
-
-int64_t floor_div(int64_t a, int64_t b) {
-  const int64_t q = a / b;
-  return (a % b != 0 && (a < 0) != (b < 0)) ? q - 1 : q;
-}
 
 // The voxel columns (of the block) one ray feeds, with its trapezoid weight in each.
 struct RayColumns {
@@ -48,11 +45,11 @@ class AxisPass {
   void run() {
     const int64_t u0 = int64_t(m_) * s_.box.lo[u_], u1 = int64_t(m_) * s_.box.hi()[u_];
     const int64_t v0 = int64_t(m_) * s_.box.lo[v_], v1 = int64_t(m_) * s_.box.hi()[v_];
-    const int cd0 = int(floor_div(int64_t(m_) * s_.box.lo[a_], c_));
-    const int cd1 = int(floor_div(int64_t(m_) * s_.box.hi()[a_] - 1, c_));
+    const int cd0 = int(detail::floor_div64(int64_t(m_) * s_.box.lo[a_], c_));
+    const int cd1 = int(detail::floor_div64(int64_t(m_) * s_.box.hi()[a_] - 1, c_));
     column_.resize(size_t(cd1 - cd0 + 1));
-    for (int64_t cv = floor_div(v0, c_); cv <= floor_div(v1, c_); ++cv) {
-      for (int64_t cu = floor_div(u0, c_); cu <= floor_div(u1, c_); ++cu) {
+    for (int64_t cv = detail::floor_div64(v0, c_); cv <= detail::floor_div64(v1, c_); ++cv) {
+      for (int64_t cu = detail::floor_div64(u0, c_); cu <= detail::floor_div64(u1, c_); ++cu) {
         glm::ivec3 c;
         c[u_] = int(cu);
         c[v_] = int(cv);
@@ -85,13 +82,13 @@ class AxisPass {
     const Chunk* data;
   };
 
-  int64_t align_up(int64_t x) const { return floor_div(x + stride_ - 1, stride_) * stride_; }
+  int64_t align_up(int64_t x) const { return detail::floor_div64(x + stride_ - 1, stride_) * stride_; }
 
   // The block columns ray (ru, rv) lies in, with their weights.
   RayColumns columns_of(int64_t ru, int64_t rv) const {
     int cu[2], wu[2], nu = 0, cv[2], wv[2], nv = 0;
     auto side = [&](int64_t r, int lo, int dims, int* col, int* w, int* n) {
-      const int64_t g = floor_div(r, m_);
+      const int64_t g = detail::floor_div64(r, m_);
       if (r == g * m_) {
         if (g - 1 >= lo && g - 1 < lo + dims) col[*n] = int(g - 1 - lo), w[(*n)++] = 1;
         if (g >= lo && g < lo + dims) col[*n] = int(g - lo), w[(*n)++] = 1;
@@ -117,7 +114,7 @@ class AxisPass {
   int weight_sum(int64_t g, int64_t r0, int64_t r1) const {
     const int64_t lo = std::max(r0, g * m_), hi = std::min(r1, g * m_ + m_);
     if (lo > hi) return 0;
-    const int64_t first = align_up(lo), last = floor_div(hi, stride_) * stride_;
+    const int64_t first = align_up(lo), last = detail::floor_div64(hi, stride_) * stride_;
     if (first > last) return 0;
     const int64_t count = (last - first) / stride_ + 1;
     return int(2 * count - (first == g * m_) - (last == g * m_ + m_));
@@ -206,7 +203,7 @@ class AxisPass {
 
   void record_face(const RayColumns& rc, int face, int bin, const PackedPoint& p) {
     const VoxelMaterial& mat = (*src_.materials)[uint16_t(p.material + src_.material_offset)];
-    const glm::vec3 n = decode_normal(p.normal & ~(kPointExitBit | kPointReservedBit));
+    const glm::vec3 n = decode_normal(p.normal);
     for (int i = 0; i < rc.count; ++i) {
       const size_t vox = rc.base[size_t(i)] + size_t(bin) * size_t(step_[a_]);
       FaceAccum& f = s_.face[vox * kFaces + size_t(face)];
@@ -386,8 +383,8 @@ ChunkKind block_kind(const VoxelSource& src, const VoxelBox& box) {
   const int c = w.chunk_size();
   glm::ivec3 c0, c1;
   for (int a = 0; a < 3; ++a) {
-    c0[a] = int(floor_div(int64_t(src.m) * box.lo[a], c));
-    c1[a] = int(floor_div(int64_t(src.m) * box.hi()[a], c));
+    c0[a] = int(detail::floor_div64(int64_t(src.m) * box.lo[a], c));
+    c1[a] = int(detail::floor_div64(int64_t(src.m) * box.hi()[a], c));
   }
   const ChunkKind first = w.chunk_kind(c0);
   if (first == ChunkKind::kMixed) return first;
@@ -471,7 +468,7 @@ std::vector<VoxelBox> split_blocks(const VoxelBox& box, int edge) {
   std::vector<VoxelBox> out;
   if (box.empty()) return out;
   const glm::ivec3 hi = box.hi();
-  auto first = [&](int lo) { return int(floor_div(lo, edge) * edge); };
+  auto first = [&](int lo) { return int(detail::floor_div64(lo, edge) * edge); };
   for (int z = first(box.lo.z); z < hi.z; z += edge) {
     for (int y = first(box.lo.y); y < hi.y; y += edge) {
       for (int x = first(box.lo.x); x < hi.x; x += edge) {

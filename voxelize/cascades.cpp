@@ -10,6 +10,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "ldc/detail/ray_math.h"
 #include "ldc/detail/vec_text.h"
 #include "voxelize/detail/voxel_common.h"
 #include "voxelize/voxelize.h"
@@ -25,15 +26,7 @@ constexpr uint32_t kAlphaMask = 0xffu << 24;
 // Largest camera coordinate in level voxels: keeps every box in int range.
 constexpr double kMaxCameraVoxel = double(1 << 28);
 
-int64_t floor_div(int64_t a, int64_t b) {
-  const int64_t q = a / b;
-  return (a % b != 0 && (a < 0) != (b < 0)) ? q - 1 : q;
-}
-
-int wrap(int g, int n) {
-  const int r = g % n;
-  return r < 0 ? r + n : r;
-}
+int wrap(int g, int n) { return detail::floor_mod(g, n); }
 glm::ivec3 wrap(const glm::ivec3& g, int n) { return {wrap(g.x, n), wrap(g.y, n), wrap(g.z, n)}; }
 
 size_t local_index(const glm::ivec3& t, int n) {
@@ -406,8 +399,8 @@ void Cascades::invalidate(std::span<const DirtyChunk> dirty) {
     for (const DirtyChunk& d : dirty) {
       VoxelBox vb;
       for (int a = 0; a < 3; ++a) {
-        const int64_t g0 = floor_div(int64_t(d.node_lo[a]) - 1, m);
-        const int64_t g1 = floor_div(int64_t(d.node_hi[a]) - 1, m);
+        const int64_t g0 = detail::floor_div64(int64_t(d.node_lo[a]) - 1, m);
+        const int64_t g1 = detail::floor_div64(int64_t(d.node_hi[a]) - 1, m);
         vb.lo[a] = int(g0);
         vb.dims[a] = int(g1 - g0 + 1);
       }

@@ -56,18 +56,18 @@ Result<ObjectWorld> build_object_world(const StaticObject& object, const glm::dv
   if (glm::determinant(glm::dmat3(object.transform)) < 0.0) {
     for (glm::uvec3& t : mesh.triangles) std::swap(t.y, t.z);  // mirrored: keep the winding outward
   }
-  if (mesh.triangle_material.empty()) {
-    mesh.triangle_material.assign(mesh.triangles.size(), object.material);
-  } else {
-    for (uint16_t& m : mesh.triangle_material) m = uint16_t(m + object.material_base);
-  }
+  // The mesh keeps its own ids (and names, which its checks match them
+  // against); material_base is added when the voxels read them.
+  const bool own_ids = !mesh.triangle_material.empty();
+  if (!own_ids) mesh.triangle_material.assign(mesh.triangles.size(), object.material);
   GridConfig grid;
   grid.cell_size = voxel_size / kObjectSupersampling;
   grid.use_origin = true;
   grid.origin = origin;
   Result<World> world = build_from_mesh(mesh, grid, ctx);
   if (!world.ok()) return Status(world.status().code(), "static object: " + world.status().message());
-  ObjectWorld out{std::move(world).value(), voxels_of_box(object_bounds(object), origin, voxel_size)};
+  ObjectWorld out{std::move(world).value(), voxels_of_box(object_bounds(object), origin, voxel_size),
+                  own_ids ? int(object.material_base) : 0};
   return out;
 }
 
@@ -78,6 +78,7 @@ VoxelSource object_source(const ObjectWorld& object, const MaterialTable& materi
   src.stride = 1;
   src.occ_axis = occ_axis;
   src.materials = &materials;
+  src.material_offset = object.material_offset;
   return src;
 }
 

@@ -20,7 +20,7 @@ struct VoxelSource {
   int stride = 1;     // sampled ray spacing [Units: nodes]; divides m
   int occ_axis = 2;   // family integrated for the volume
   const MaterialTable* materials = nullptr;
-  // Added to the material ids read from the points (static objects).
+  // Added to the material ids read from the points (a static object's material_base).
   int material_offset = 0;
 };
 

@@ -13,6 +13,7 @@ inline constexpr int kObjectSupersampling = 16;
 struct ObjectWorld {
   World world;
   VoxelBox voxels;  // the voxels (of size s) the object's bounds touch
+  int material_offset = 0;  // added to the ids its points hold (material_base)
 };
 
 // The object's world-space bounds (transformed vertices).
