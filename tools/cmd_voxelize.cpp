@@ -33,11 +33,8 @@ struct VoxelizeArgs {
 enum class Format { kVdb, kRaw };
 
 Result<Format> output_format(const std::string& path) {
-  auto ends = [&](const std::string& e) {
-    return path.size() > e.size() && path.compare(path.size() - e.size(), e.size(), e) == 0;
-  };
-  if (ends(".vdb")) return Format::kVdb;
-  if (ends(".json") || ends(".raw")) return Format::kRaw;
+  if (path.ends_with(".vdb")) return Format::kVdb;
+  if (path.ends_with(".json") || path.ends_with(".raw")) return Format::kRaw;
   return Status(ErrorCode::kInvalidArgument, "-o " + path + ": unknown output format (use .vdb, .json or .raw)");
 }
 
@@ -118,7 +115,7 @@ void print_text(const nlohmann::json& j) {
                 j["chunk_columns_closed"].get<size_t>(), j["chunk_columns_walked"].get<size_t>(),
                 j["rays_walked"].get<size_t>());
   } else {
-    std::printf("voxelize: %zu cascade levels of %d^3 voxels around (%s), %.3f s\n", j["levels"].size(),
+    std::printf("voxelize: %zu cascade levels of %d^3 voxels around %s, %.3f s\n", j["levels"].size(),
                 j["resolution"].get<int>(), detail::vec_text({j["camera"][0].get<double>(), j["camera"][1].get<double>(),
                                                                j["camera"][2].get<double>()}).c_str(),
                 j["voxelize_seconds"].get<double>());
@@ -135,7 +132,7 @@ int run_voxelize(const VoxelizeArgs& a, const CommonOptions& common) {
   if (!format.ok()) return fail("voxelize", format.status());
   Result<int> axis = parse_axis(a.axis);
   if (!axis.ok()) return fail("voxelize", axis.status());
-  if (a.cascades < 0) return fail("voxelize", "--cascades " + std::to_string(a.cascades) + ": must be >= 1");
+  if (a.cascades < 0) return fail("voxelize", "--cascades " + std::to_string(a.cascades) + ": must be >= 0 (0: one dense grid)");
   if (a.cascades == 0 && !a.camera.empty()) return fail("voxelize", "--camera needs --cascades K");
   Result<World> world = load_world(a.world);
   if (!world.ok()) return fail("voxelize", world.status());
