@@ -7,8 +7,10 @@ seconds=${1:-60}
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
   -DLDC_BUILD_FUZZERS=ON -DLDC_BUILD_TESTS=OFF -DLDC_BUILD_TOOLS=OFF \
   -DLDC_BUILD_CAPI=OFF -DLDC_BUILD_EXAMPLES=OFF -DLDC_INSTALL=OFF >/dev/null
-cmake --build build-fuzz -j "$(nproc 2>/dev/null || echo 2)"
-for target in fuzz_ldc_load fuzz_mesh_parsers fuzz_edits; do
+targets=(fuzz_ldc_load fuzz_mesh_parsers fuzz_edits)
+# Only the fuzzers and what they link (not nav, voxelize, GI and their shaders).
+cmake --build build-fuzz -j "$(nproc 2>/dev/null || echo 2)" --target "${targets[@]}"
+for target in "${targets[@]}"; do
   corpus=$(mktemp -d)
   cp fuzz/corpus/${target#fuzz_}/* "$corpus"/ 2>/dev/null || true
   echo "fuzzing $target for ${seconds}s"

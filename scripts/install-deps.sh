@@ -15,7 +15,8 @@ packages=(
   libcli11-dev nlohmann-json3-dev
   # tests, fuzzing, benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev clang libclang-rt-14-dev
-  # benchmark peers (Embree: also the ray-cast agreement tests; Recast/Detour: bench_nav)
+  # OpenVDB: the .vdb export (voxelize_vdb, built with the tool and tests); peers in the
+  # benchmarks: Embree (also the ray-cast agreement tests and the GI path tracer), Recast/Detour
   libopenvdb-dev libboost-iostreams-dev libembree-dev librecast-dev
   # gi_bridge (issue 8): Vulkan loader and headers, Mesa's lavapipe (CPU Vulkan), glslc
   libvulkan-dev mesa-vulkan-drivers glslc
