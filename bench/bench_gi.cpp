@@ -7,7 +7,8 @@
 // a staggered frame, and the error (near/far split off and on) of
 // the cone-traced irradiance against the path-traced reference (Embree on
 // the contoured mesh) at the same points, for 1, 2 and 3 bounces.
-// Usage: bench_gi [points (200)] [paths per point (512)]
+// Usage: bench_gi [points (200)] [paths per point (512)] [sources: only the
+// error split by light source]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -112,6 +113,21 @@ Scene shared_mesh() {
   return s;
 }
 
+// The furnace: a closed box whose walls all glow (emission 1, albedo 0.5),
+// so every inside point has irradiance pi (1 bounce), 1.5 pi, 1.75 pi.
+Scene furnace() {
+  TriangleMesh m;
+  add_box(m, {-1.6, -1.6, -1.6}, {1.6, 1.6, -0.8}, 0);
+  add_box(m, {-1.6, -1.6, 0.8}, {1.6, 1.6, 1.6}, 0);
+  add_box(m, {-1.6, 0.8, -1.6}, {1.6, 1.6, 1.6}, 0);
+  add_box(m, {-1.6, -1.6, -1.6}, {1.6, -0.8, 1.6}, 0);
+  add_box(m, {-1.6, -1.6, -1.6}, {-0.8, 1.6, 1.6}, 0);
+  add_box(m, {0.8, -1.6, -1.6}, {1.6, 1.6, 1.6}, 0);
+  Scene s{"furnace (closed glowing box)", build(m, 0.05), {0.0, 0.0, 0.0}, {}, {}};
+  s.materials.materials = {{glm::vec3(0.5f), glm::vec3(1.0f)}};
+  return s;
+}
+
 // Query points: random triangles of the contoured mesh within `radius` of the camera.
 void query_points(const ContourMesh& mesh, const glm::dvec3& c, double radius, int count, std::vector<glm::dvec3>& p,
                   std::vector<glm::vec3>& n) {
@@ -150,18 +166,28 @@ Stats rel_error(const std::vector<glm::vec3>& a, const std::vector<glm::vec3>& r
   return st;
 }
 
-void run(const Scene& s, int points, int paths) {
-  std::printf("\n## %s\n", s.name.c_str());
+// Six levels of 32^3 voxels of about 0.1 m (a whole number of cells),
+// centred on the scene's camera.
+Result<Cascades> bench_cascades(const Scene& s, const MaterialTable& materials) {
   CascadeConfig cc;
   cc.levels = 6;
   cc.resolution = 32;
   cc.voxel_size = s.world.lattice().cell_size * std::max(1.0, std::round(0.1 / s.world.lattice().cell_size));
-  cc.materials = s.materials;
+  cc.materials = materials;
   Result<Cascades> cas = Cascades::create(s.world.lattice(), cc);
-  if (!cas.ok() || !cas.value().update_all(s.world, s.camera).ok()) {
-    std::printf("cascades failed\n");
+  if (!cas.ok()) return cas;
+  if (Status st = cas.value().update_all(s.world, s.camera); !st.ok()) return st;
+  return cas;
+}
+
+void run(const Scene& s, int points, int paths) {
+  std::printf("\n## %s\n", s.name.c_str());
+  Result<Cascades> cas = bench_cascades(s, s.materials);
+  if (!cas.ok()) {
+    std::printf("cascades failed: %s\n", cas.status().message().c_str());
     return;
   }
+  const double voxel_size = cas.value().voxel_size(0);
   std::string device;
   std::vector<glm::vec3> gi_e[2][3];  // [near/far split off, on][bounces - 1]
   Result<ContourMesh> mesh = contour_world(s.world);
@@ -170,7 +196,7 @@ void run(const Scene& s, int points, int paths) {
   std::vector<glm::vec3> n;
   query_points(mesh.value(), s.camera, 1.5, points, p, n);
   std::printf("cascades: 6 levels of 32^3, level 0 voxel %.3g m; %zu query points within 1.5 m of the camera\n",
-              cc.voxel_size, p.size());
+              voxel_size, p.size());
   std::printf("| engine | precombined | near/far split | load s | level 0 s | level 1 s | level 2 s | level 3 s | level 4 s | level 5 s | full update s | staggered frame s (mean of 16) | surface voxels |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   // Vulkan (lavapipe here) with and without the precombined buffers and
   // with the near/far split cones, then the CPU engine for reference.
@@ -244,12 +270,60 @@ void run(const Scene& s, int points, int paths) {
   }
 }
 
+// The error split by light source (sky, point light, emitter alone), each
+// with 1..3 bounces, on the CPU engine: says which term the error comes from.
+void by_source(const Scene& s, int points, int paths) {
+  std::printf("\n### %s: error by light source (cpu engine)\n", s.name.c_str());
+  Result<ContourMesh> mesh = contour_world(s.world);
+  if (!mesh.ok()) return;
+  std::vector<glm::dvec3> p;
+  std::vector<glm::vec3> n;
+  query_points(mesh.value(), s.camera, 1.5, points, p, n);
+  std::printf("| source | bounces | mean rel. error | p95 rel. error | mean cone-traced | mean path-traced |\n|---|---|---|---|---|---|\n");
+  for (int src = 0; src < 3; ++src) {
+    GiLights lights;
+    MaterialTable mats = s.materials;
+    if (src == 0) lights.sky = s.lights.sky;
+    if (src == 1) lights.points = s.lights.points;
+    if (src != 2) {
+      for (VoxelMaterial& m : mats.materials) m.emission = glm::vec3(0.0f);
+    }
+    bool present = src == 1 ? !lights.points.empty() : false;
+    for (int i = 0; i < kGiDirections && src == 0; ++i) present = present || lum(lights.sky.amplitude[size_t(i)]) > 0;
+    for (const VoxelMaterial& m : mats.materials) present = present || (src == 2 && lum(m.emission) > 0);
+    if (!present) continue;
+    Result<Cascades> cas = bench_cascades(s, mats);
+    if (!cas.ok()) return;
+    std::unique_ptr<GiEngine> g = make_cpu_gi();
+    if (!g->load(cas.value(), lights).ok() || !g->update_all(3).ok()) return;
+    Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), mats, lights);
+    if (!pt.ok()) return;
+    for (int b = 1; b <= 3; ++b) {
+      std::vector<glm::vec3> e(p.size()), ref(p.size());
+      (void)g->irradiance(p, n, b, e);
+      PathTraceConfig pc;
+      pc.samples = paths;
+      (void)pt.value()->irradiance(p, n, b, ref, pc);
+      const Stats st = rel_error(e, ref);
+      double mg = 0, mr = 0;
+      for (size_t i = 0; i < p.size(); ++i) mg += lum(e[i]) / double(p.size()), mr += lum(ref[i]) / double(p.size());
+      const char* names[] = {"sky", "point light", "emission"};
+      std::printf("| %s | %d | %.1f%% | %.1f%% | %.3f | %.3f |\n", names[src], b, 100 * st.mean, 100 * st.p95, mg, mr);
+    }
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const int points = argc > 1 ? std::atoi(argv[1]) : 200;
   const int paths = argc > 2 ? std::atoi(argv[2]) : 512;
   std::printf("# bench_gi: cone-traced GI (Vulkan engine rows name their device; llvmpipe = Mesa's lavapipe on the CPU) vs path-traced reference\n");
+  if (argc > 3 && std::string(argv[3]) == "sources") {
+    by_source(cornell(), points, paths);
+    by_source(furnace(), points, paths);
+    return 0;
+  }
   run(cornell(), points, paths);
   run(landscape(), points, paths);
   run(shared_mesh(), points, paths);

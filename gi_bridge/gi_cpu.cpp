@@ -18,6 +18,7 @@ using glm::clamp;
 using glm::dot;
 using glm::exp;
 using glm::floor;
+using glm::inversesqrt;
 using glm::length;
 using glm::max;
 using glm::min;
@@ -25,7 +26,7 @@ using glm::sqrt;
 
 struct Buffers {
   std::vector<float> occ, alpha;
-  std::vector<int32_t> vmap;
+  std::vector<int32_t> vmap, fsrc;
   std::vector<ivec4> surf_pos;
   std::vector<vec4> attr, light_prev, light_next, pre, qin, qout;
 };
@@ -33,6 +34,7 @@ struct Buffers {
 #define GI_CONST static constexpr
 #define OUT(T) T&
 #define INOUT(T) T&
+#define INOUT_ARRAY(T) T
 #define XYZ(v) vec3(v)
 #define IXYZ(v) ivec3(v)
 
@@ -49,6 +51,7 @@ struct Kernels {
   int vmap_load(int i) const { return b->vmap[size_t(i)]; }
   ivec4 surf_pos_load(int i) const { return b->surf_pos[size_t(i)]; }
   vec4 attr_load(int i) const { return b->attr[size_t(i)]; }
+  int fsrc_load(int i) const { return b->fsrc[size_t(i)]; }
   vec4 light_load(int i) const { return b->light_prev[size_t(i)]; }
   void light_store(int i, vec4 v) const { b->light_next[size_t(i)] = v; }
   vec4 pre_load(int i) const { return b->pre[size_t(i)]; }
@@ -62,6 +65,7 @@ struct Kernels {
 #undef GI_CONST
 #undef OUT
 #undef INOUT
+#undef INOUT_ARRAY
 #undef XYZ
 #undef IXYZ
 
@@ -77,6 +81,7 @@ class CpuGi final : public GiEngineBase {
     b_.vmap = layout.vmap;
     b_.surf_pos = layout.surf_pos;
     b_.attr = layout.attr;
+    b_.fsrc = layout.face_src;
     b_.alpha.assign(layout.voxels() * 16, 0.0f);
     b_.light_prev.assign(layout.surfaces() * 18, vec4(0.0f));
     b_.light_next = b_.light_prev;

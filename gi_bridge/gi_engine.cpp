@@ -121,37 +121,83 @@ void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfi
   for (int l = 0; l < out.k; ++l) p.lo[l] = glm::ivec4(cascades.level_box(l).lo, 0);
 }
 
-// Surface voxels of one level: those with a face holding its own surface.
+bool s_is_updated(const GiLayout& out, int l, int32_t s) {
+  return s >= out.level_first[size_t(l)] && s < out.level_first[size_t(l)] + out.level_count[size_t(l)];
+}
+
+bool own_face(const FaceSample& f) { return (f.flags & kFaceOwn) && f.albedo.a > 0.0f; }
+bool propagated_face(const FaceSample& f) { return f.flags == kFacePropagated && f.albedo.a > 0.0f; }
+
+// Entries of one level: first the surface voxels (a face holding its own
+// surface), then the shadow voxels (solid behind a surface, a face
+// propagated from it). A propagated face shows its neighbour's light: a
+// cone entering a wall samples the surface voxel and the solid one behind
+// it together, and without that light the wall looked half as bright as it
+// is (a closed emissive box gave irradiance 1.58 instead of pi).
 void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
   const int n = out.n;
+  const size_t level_base = size_t(l) * size_t(n) * n * n;
+  auto voxel_of = [&](const glm::ivec3& c) { return level_base + (size_t(c.z) * n + size_t(c.y)) * n + size_t(c.x); };
   out.level_first[size_t(l)] = int(out.surf_pos.size());
+  std::vector<glm::ivec3> shadows;
+  auto add_entry = [&](const glm::ivec3& c, const FaceSample* f, bool updated) {
+    out.vmap[voxel_of(c)] = int32_t(out.surf_pos.size());
+    out.surf_pos.emplace_back(c, l);
+    for (int i = 0; i < kFaces; ++i) {
+      out.attr.emplace_back(glm::vec3(f[i].albedo), updated && own_face(f[i]) ? f[i].albedo.a : 0.0f);
+      out.attr.emplace_back(f[i].normal, 0.0f);
+      out.attr.emplace_back(f[i].emission, 0.0f);
+    }
+  };
   for (int z = 0; z < n; ++z) {
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
         const glm::ivec3 c(x, y, z);
-        const size_t voxel = size_t(l) * size_t(n) * n * n + (size_t(z) * n + size_t(y)) * n + size_t(x);
+        const size_t voxel = voxel_of(c);
         out.vmap[voxel] = -1;
         if (!valid) continue;
         FaceSample f[kFaces];
-        bool surface = false;
+        bool surface = false, shadow = false;
         for (int i = 0; i < kFaces; ++i) {
           f[i] = packed.sample(i, l, c);
           out.occ[voxel * 6 + size_t(i)] = f[i].occupancy;
-          surface = surface || ((f[i].flags & kFaceOwn) && f[i].albedo.a > 0.0f);
+          surface = surface || own_face(f[i]);
+          shadow = shadow || propagated_face(f[i]);
         }
-        if (!surface) continue;
-        out.vmap[voxel] = int32_t(out.surf_pos.size());
-        out.surf_pos.emplace_back(c, l);
-        for (int i = 0; i < kFaces; ++i) {
-          const bool own = (f[i].flags & kFaceOwn) && f[i].albedo.a > 0.0f;
-          out.attr.emplace_back(glm::vec3(f[i].albedo), own ? f[i].albedo.a : 0.0f);
-          out.attr.emplace_back(f[i].normal, 0.0f);
-          out.attr.emplace_back(f[i].emission, 0.0f);
+        if (surface) {
+          add_entry(c, f, true);
+        } else if (shadow) {
+          shadows.push_back(c);
         }
       }
     }
   }
   out.level_count[size_t(l)] = int(out.surf_pos.size()) - out.level_first[size_t(l)];
+  for (const glm::ivec3& c : shadows) {
+    FaceSample f[kFaces];
+    for (int i = 0; i < kFaces; ++i) f[i] = packed.sample(i, l, c);
+    add_entry(c, f, false);
+  }
+  out.level_shadow[size_t(l)] = int(out.surf_pos.size()) - out.level_first[size_t(l)] - out.level_count[size_t(l)];
+  // Which light slot each face shows: its own, or its neighbour's on that side.
+  for (size_t s = size_t(out.level_first[size_t(l)]); s < out.surf_pos.size(); ++s) {
+    const glm::ivec3 c(out.surf_pos[s]);
+    for (int i = 0; i < kFaces; ++i) {
+      const glm::vec4& albedo = out.attr[(s * 6 + size_t(i)) * 3];
+      int32_t src = -1;
+      if (packed.sample(i, l, c).flags == kFaceOwn) {
+        if (albedo.w > 0.0f) src = int32_t(s * 6 + size_t(i));
+      } else if (propagated_face(packed.sample(i, l, c))) {
+        glm::ivec3 nb = c;
+        nb[face_axis(i)] += face_positive(i) ? 1 : -1;
+        const int32_t t = glm::all(glm::greaterThanEqual(nb, glm::ivec3(0))) && glm::all(glm::lessThan(nb, glm::ivec3(n)))
+                              ? out.vmap[voxel_of(nb)]
+                              : -1;
+        if (t >= 0 && s_is_updated(out, l, t)) src = t * 6 + i;
+      }
+      out.face_src.push_back(src);
+    }
+  }
 }
 
 }  // namespace
@@ -176,6 +222,7 @@ Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& light
   out.vmap.assign(out.voxels(), -1);
   out.level_first.assign(size_t(out.k), 0);
   out.level_count.assign(size_t(out.k), 0);
+  out.level_shadow.assign(size_t(out.k), 0);
   for (int l = 0; l < out.k; ++l) add_level(packed, l, cascades.level_valid(l), out);
   return out;
 }
@@ -214,7 +261,8 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
     if (c == 0) continue;
     if (Status s = commit(first, c); !s.ok()) return s;
     if (config_.precombined) {
-      if (Status s = run(GiKernel::kPrecombine, first * 16, c * 16, l); !s.ok()) return s;
+      const int all = c + layout_.level_shadow[size_t(l)];
+      if (Status s = run(GiKernel::kPrecombine, first * 16, all * 16, l); !s.ok()) return s;
     }
   }
   t.levels_updated = int(levels.size());
@@ -272,12 +320,14 @@ Result<GiRadiance> GiEngineBase::radiance() {
   std::vector<glm::vec4> light;
   if (Status s = read_light(light); !s.ok()) return s;
   GiRadiance r;
-  r.voxels.resize(layout_.surfaces());
-  r.light.resize(layout_.surfaces());
-  for (size_t s = 0; s < layout_.surfaces(); ++s) {
-    const glm::ivec4 p = layout_.surf_pos[s];
-    r.voxels[s] = glm::ivec4(glm::ivec3(p) + glm::ivec3(layout_.params.lo[p.w]), p.w);
-    for (int j = 0; j < 18; ++j) r.light[s][size_t(j)] = glm::vec3(light[s * 18 + size_t(j)]);
+  for (int l = 0; l < layout_.k; ++l) {
+    const size_t first = size_t(layout_.level_first[size_t(l)]);
+    for (size_t s = first; s < first + size_t(layout_.level_count[size_t(l)]); ++s) {
+      const glm::ivec4 p = layout_.surf_pos[s];
+      r.voxels.emplace_back(glm::ivec3(p) + glm::ivec3(layout_.params.lo[p.w]), p.w);
+      std::array<glm::vec3, 18>& faces = r.light.emplace_back();
+      for (int j = 0; j < 18; ++j) faces[size_t(j)] = glm::vec3(light[s * 18 + size_t(j)]);
+    }
   }
   return r;
 }

@@ -25,7 +25,7 @@ const uint32_t kSpvQuery[] =
 #include "gi_kernel4.spv.inc"
     ;
 
-constexpr int kBindings = 11;
+constexpr int kBindings = 12;
 constexpr int kGroup = 64;         // local_size_x
 constexpr int kMaxGroups = 65535;  // per dispatch (the guaranteed minimum)
 
@@ -282,6 +282,7 @@ Status VulkanGi::upload(const GiLayout& layout) {
   if (st.ok()) st = make_buffer(8, s * 48 * sizeof(glm::vec4), nullptr);
   if (st.ok() && !buffers_[9].buffer) st = make_buffer(9, 32, nullptr);
   if (st.ok() && !buffers_[10].buffer) st = make_buffer(10, 16, nullptr);
+  if (st.ok()) st = make_buffer(11, bytes(layout.face_src), layout.face_src.data());
   if (!st.ok()) return st;
   write_descriptors();
   return {};

@@ -68,10 +68,12 @@ TEST(GiCpu, ClosedRoomWithSkyOutsideIsBlackInside) {
   const std::vector<glm::vec3> n = {{0, 0, 1}, {0, 0, -1}, {-1, 0, 0}, {0, 1, 0}};
   std::vector<glm::vec3> e(p.size());
   ASSERT_TRUE(gi->irradiance(p, n, 3, e).ok());
-  // Under 0.1% of the sky's pi outside: the coarsest voxels holding both the
+  // Under 0.2% of the sky's pi outside: the coarsest voxels holding both the
   // room and its walls are not counted by cones starting inside them (see
-  // sample_corner), which lets about 5e-4 of the sky through.
-  for (const glm::vec3& v : e) EXPECT_LT(luminance(v), 3e-3f);
+  // sample_corner), which lets 1.2e-3 of the sky through (measured 0 ..
+  // 3.7e-3 at these points; 1.6e-3 at most before propagated faces showed
+  // light).
+  for (const glm::vec3& v : e) EXPECT_LT(luminance(v), 6e-3f);
   // Outside, the roof sees the sky.
   std::vector<glm::vec3> top(1);
   ASSERT_TRUE(gi->irradiance(std::vector<glm::dvec3>{{0, 0, 2.4}}, std::vector<glm::vec3>{{0, 0, 1}}, 1, top).ok());
@@ -169,6 +171,59 @@ TEST(GiCpu, EnergyDoesNotGrowWithBounces) {
   EXPECT_LT(luminance(e3[0]) - luminance(e2[0]), luminance(e2[0]) - luminance(e1[0]));
 }
 
+// A closed room whose walls all glow (emission 4, albedo 0.7): every inside
+// point sees radiance 4 after 1 bounce, 4 * 1.7 after 2 and 4 * 2.19 after
+// 3 (the "furnace" test). Cones entering a wall sample its surface voxels
+// and the solid ones behind together; before the faces behind a surface
+// showed its light (GiLayout::face_src) and before hidden faces were left
+// out of the light's mean (blend_light_faces) the walls looked half as
+// bright as they are.
+TEST(GiCpu, GlowingClosedRoomGivesTheFurnaceIrradiance) {
+  const World world = test::build_boxes(test::closed_room(2));
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  ASSERT_TRUE(gi->load(cas, GiLights{}).ok());
+  ASSERT_TRUE(gi->update_all(3).ok());
+  const std::vector<glm::dvec3> p = {{0, 0, -0.8}, {0.3, -0.2, 0.8}, {0.8, 0.3, 0.2}, {-0.5, 0.8, -0.5}, {-0.6, -0.6, -0.8}};
+  const std::vector<glm::vec3> n = {{0, 0, 1}, {0, 0, -1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}};
+  const float pi = 3.14159265f;
+  // Measured: 0.87 .. 0.99 of the exact value after 1 bounce, 0.84 .. 0.95
+  // after 2, 0.81 .. 0.92 after 3 (the corners' cones lose the most).
+  for (int b = 1; b <= 3; ++b) {
+    std::vector<glm::vec3> e(p.size());
+    ASSERT_TRUE(gi->irradiance(p, n, b, e).ok());
+    const float exact = 4.0f * pi * (b == 1 ? 1.0f : b == 2 ? 1.7f : 2.19f);
+    const float low = b == 1 ? 0.85f : b == 2 ? 0.8f : 0.75f;
+    for (size_t i = 0; i < p.size(); ++i) {
+      EXPECT_GT(luminance(e[i]), low * exact) << "bounces " << b << ", point " << i;
+      EXPECT_LT(luminance(e[i]), 1.02f * exact) << "bounces " << b << ", point " << i;
+    }
+  }
+}
+
+// A point light over a black open plane: irradiance I cos / r^2 exactly
+// where nothing is in the way (the cosine and distance are the light's;
+// the cones only say how much of it is hidden).
+TEST(GiCpu, PointLightOverAnOpenPlaneGivesTheInverseSquareLaw) {
+  const World world = test::build_boxes({{{-30, -30, -1}, {30, 30, 0}, 1}});
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  GiLights lights;
+  const glm::dvec3 light(0.1, 0.3, 1.0);
+  lights.points.push_back({light, glm::vec3(2.0f)});
+  ASSERT_TRUE(gi->load(cas, lights).ok());
+  ASSERT_TRUE(gi->update_all(1).ok());
+  const std::vector<glm::dvec3> p = {{0.1, 0.3, 0}, {0.6, 0.1, 0}, {-0.7, -0.4, 0}, {1.3, 1.1, 0}, {-1.5, 0.9, 0}};
+  const std::vector<glm::vec3> n(p.size(), glm::vec3(0, 0, 1));
+  std::vector<glm::vec3> e(p.size());
+  ASSERT_TRUE(gi->irradiance(p, n, 1, e).ok());
+  for (size_t i = 0; i < p.size(); ++i) {
+    const glm::dvec3 to = light - p[i];
+    const double exact = 2.0 * to.z / std::pow(glm::length(to), 3.0);
+    EXPECT_NEAR(luminance(e[i]), exact, 0.06 * exact) << "point " << i << ": tolerance 6%";
+  }
+}
+
 TEST(GiCpu, PrecombinedAndThreeFaceLookupsAgree) {
   std::vector<GiBox> boxes = test::closed_room(3);
   boxes[5].hi.z = 0.0;  // open the +y wall's upper half to the sky
@@ -212,7 +267,7 @@ TEST(GiCpu, NearFarSplitConesKeepWallsClosedAndTheSkyOpen) {
     ASSERT_TRUE(gi->irradiance(std::vector<glm::dvec3>{{0, 0, -0.8}, {0.8, 0.3, 0.2}},
                                std::vector<glm::vec3>{{0, 0, 1}, {-1, 0, 0}}, 3, e)
                     .ok());
-    for (const glm::vec3& v : e) EXPECT_LT(luminance(v), 3e-3f);  // as without the split
+    for (const glm::vec3& v : e) EXPECT_LT(luminance(v), 6e-3f);  // as without the split
   }
   {
     const World world = test::build_boxes({{{0.0, -20, -20}, {0.2, 20, 20}, 0}});

@@ -42,7 +42,11 @@ struct GiLayout {
   std::vector<int32_t> vmap;          // K N^3
   std::vector<glm::ivec4> surf_pos;   // S: local xyz, level
   std::vector<glm::vec4> attr;        // S * 18
-  std::vector<int> level_first, level_count;
+  std::vector<int32_t> face_src;      // S * 6: light slot (s * 6 + face) a face shows, or -1
+  // Per level the entries start at level_first: level_count surface voxels
+  // (updated), then level_shadow voxels that only show their neighbours'
+  // light on propagated faces (precombined, never updated).
+  std::vector<int> level_first, level_count, level_shadow;
   size_t voxels() const { return size_t(k) * size_t(n) * size_t(n) * size_t(n); }
   size_t surfaces() const { return surf_pos.size(); }
 };

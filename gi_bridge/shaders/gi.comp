@@ -6,6 +6,7 @@ layout(local_size_x = 64) in;
 #define GI_CONST const
 #define OUT(T) out T
 #define INOUT(T) inout T
+#define INOUT_ARRAY(T) inout T
 #define XYZ(v) (v).xyz
 #define IXYZ(v) (v).xyz
 
@@ -37,6 +38,7 @@ layout(std430, binding = 7) writeonly buffer LightNext { vec4 v[]; } light_next_
 layout(std430, binding = 8) buffer Pre { vec4 v[]; } pre_buf;
 layout(std430, binding = 9) readonly buffer QIn { vec4 v[]; } qin_buf;
 layout(std430, binding = 10) writeonly buffer QOut { vec4 v[]; } qout_buf;
+layout(std430, binding = 11) readonly buffer FSrc { int v[]; } fsrc_buf;
 
 float occ_load(int i) { return occ_buf.v[i]; }
 float alpha_load(int i) { return alpha_buf.v[i]; }
@@ -44,6 +46,7 @@ void alpha_store(int i, float a) { alpha_buf.v[i] = a; }
 int vmap_load(int i) { return vmap_buf.v[i]; }
 ivec4 surf_pos_load(int i) { return surf_pos_buf.v[i]; }
 vec4 attr_load(int i) { return attr_buf.v[i]; }
+int fsrc_load(int i) { return fsrc_buf.v[i]; }
 vec4 light_load(int i) { return light_prev_buf.v[i]; }
 void light_store(int i, vec4 v) { light_next_buf.v[i] = v; }
 vec4 pre_load(int i) { return pre_buf.v[i]; }
