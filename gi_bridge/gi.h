@@ -20,9 +20,11 @@
 // back at the apex, weighted by d_axis^2; a corner counts only when its
 // voxel lies wholly ahead of the plane through the apex normal to the axis,
 // so a cone never reads the coarse voxel holding its own surface) and light
-// premultiplied by opacity,
-// composited front to back as in volume ray marching (opacity corrected for
-// the half-voxel step: 1 - sqrt(1 - a)). A cone that leaves the coarsest
+// premultiplied by opacity: the mean light of the faces that show a surface
+// (their own, or one propagated from the surface in front, see Light)
+// among the faces on the apex's side of the voxel, times a. Composited
+// front to back as in volume ray marching (opacity corrected for the
+// half-voxel step: 1 - sqrt(1 - a)). A cone that leaves the coarsest
 // level receives the sky times its transmittance.
 //
 // Light. Per surface voxel and face the cascades hold three radiance buffers
@@ -39,10 +41,17 @@
 // partition of unity: L_sky(w) = sum_i a_i B_i(w), B_i = exp(k (w . d_i - 1))
 // / sum_j exp(k (w . d_j - 1)). A cone i that escapes gets a_i.
 // Point lights (at most kGiMaxPointLights): radiant intensity I
-// [radiance * m^2]; a cone picks a light up at the step where its march
-// passes the light's distance r, with weight B_i(w_light) I / (Omega r^2) and
-// the transmittance gathered so far (a light list, not yet the talk's
-// cascaded volume that lights are injected into).
+// [radiance * m^2]. Their irradiance at a point (or voxel face) with normal
+// n is the exact I max(0, n . w) / r^2 times a visibility: the
+// transmittance each cone had gathered where its march passed the light's
+// distance, blended by the lights' radial basis weights B_i(w) over the
+// cones traced. So an unoccluded light is exact and the cones give soft
+// shadows with the occlusion built so far. (The talk injects lights into a
+// cascaded volume that the cones read; this is a list, not yet that.)
+// Faces behind a surface: the voxelizer propagates a surface's face to the
+// solid voxel behind it (voxelize.h); that face shows the surface's light
+// (GiLayout::face_src), so a cone entering a wall, which samples both
+// voxels, sees the wall's full radiance.
 // Emission (MaterialTable) is written into D directly.
 //
 // Outputs: radiance() reads back the per-face light cascades; irradiance()
@@ -115,12 +124,11 @@ struct GiConfig {
   // composited behind it (L_near + T_near * L_far). Off: the centre's
   // cones, from one voxel on, are shared whole by the faces (cheaper; the
   // faces then see no detail nearer than a voxel from the centre).
-  // Measured (bench_gi 60 128, closing note "Near/far split cones"): mean
-  // error vs the path tracer -1.0 to -1.5 points on the landscape, within
-  // +-0.4 on the Cornell box and spot; full update time 0.93-1.05x on the
-  // CPU engine, 0.98-1.54x on lavapipe (single runs, noisy). A grey plane's direct sky light
-  // rises from 83% to 93% of exact. Off by default: no clear gain on the
-  // benchmark and the per-face marches are unmeasured on a GPU.
+  // Measured (bench_gi 200 512, docs/benchmarks.md): mean error vs the
+  // path tracer -0.3 to -0.6 points on the landscape, +0.5 to +1.7 on the
+  // Cornell box and spot; full update time 0.96-1.24x on the CPU engine,
+  // 0.99-1.26x on lavapipe (single runs, noisy). Off by default: no clear
+  // gain on the benchmark and the per-face marches are unmeasured on a GPU.
   // [Default: off]
   bool near_far = false;
   // Where the far part starts. [Units: voxels of the updated level] [Limit: 1 .. 16] [Default: 2.5 (the

@@ -202,6 +202,23 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
   }
   if (!stbi_write_png(a.output.c_str(), wdt * cols, hgt, 3, rgb.data(), wdt * cols * 3))
     return fail("gi", "-o " + a.output + ": cannot write the PNG");
+  if (common.json) {
+    nlohmann::json j{{"device", device},
+                     {"levels", a.levels},
+                     {"resolution", a.resolution},
+                     {"voxel_size", cc.voxel_size},
+                     {"surface_voxels", upd.value().surface_voxels / size_t(a.passes)},
+                     {"passes", a.passes},
+                     {"seconds", {{"voxelize", vox_s}, {"lighting", upd.value().seconds}, {"image", img_s}}},
+                     {"image", {{"width", wdt}, {"height", hgt}, {"bounces", a.bounces}}},
+                     {"output", a.output}};
+    if (a.reference) {
+      j["reference"] = {{"samples", a.samples}};
+      j["seconds"]["reference"] = ref_s;
+    }
+    std::printf("%s\n", j.dump(2).c_str());
+    return 0;
+  }
   std::printf("gi: %s, %d levels of %d^3 voxels of %.3g m, %zu surface voxels; voxelize %.3f s\n", device.c_str(),
               a.levels, a.resolution, cc.voxel_size, upd.value().surface_voxels / size_t(a.passes), vox_s);
   std::printf("gi: %d lighting passes %.3f s (%.3f s each), image %d x %d (%d bounces) %.3f s\n", a.passes,

@@ -350,7 +350,7 @@ void kernel_update(int gid) {
     src[i] = cr.src;
     gd[i] = cr.d;
     gb1[i] = cr.b1;
-    for (int j = 0; j < 8; ++j) far_vis[i * 8 + j] = cr.vis[j];
+    for (int j = 0; j < gi_lights(); ++j) far_vis[i * 8 + j] = cr.vis[j];
     if (!split) add_light_visibility(apex, i, cr.vis, vis_sum, weight_sum);
   }
   for (int f = 0; f < 6; ++f) {
