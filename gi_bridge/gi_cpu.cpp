@@ -34,7 +34,6 @@ struct Buffers {
 #define GI_CONST static constexpr
 #define OUT(T) T&
 #define INOUT(T) T&
-#define INOUT_ARRAY(T) T
 #define XYZ(v) vec3(v)
 #define IXYZ(v) ivec3(v)
 
@@ -65,7 +64,6 @@ struct Kernels {
 #undef GI_CONST
 #undef OUT
 #undef INOUT
-#undef INOUT_ARRAY
 #undef XYZ
 #undef IXYZ
 

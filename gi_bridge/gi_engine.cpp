@@ -183,11 +183,12 @@ void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
   for (size_t s = size_t(out.level_first[size_t(l)]); s < out.surf_pos.size(); ++s) {
     const glm::ivec3 c(out.surf_pos[s]);
     for (int i = 0; i < kFaces; ++i) {
-      const glm::vec4& albedo = out.attr[(s * 6 + size_t(i)) * 3];
+      const FaceSample f = packed.sample(i, l, c);
       int32_t src = -1;
-      if (packed.sample(i, l, c).flags == kFaceOwn) {
-        if (albedo.w > 0.0f) src = int32_t(s * 6 + size_t(i));
-      } else if (propagated_face(packed.sample(i, l, c))) {
+      if (own_face(f)) {
+        // Shadow entries never hold an own face (they have no surface).
+        src = int32_t(s * 6 + size_t(i));
+      } else if (propagated_face(f)) {
         glm::ivec3 nb = c;
         nb[face_axis(i)] += face_positive(i) ? 1 : -1;
         const int32_t t = glm::all(glm::greaterThanEqual(nb, glm::ivec3(0))) && glm::all(glm::lessThan(nb, glm::ivec3(n)))

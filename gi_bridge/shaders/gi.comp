@@ -6,7 +6,6 @@ layout(local_size_x = 64) in;
 #define GI_CONST const
 #define OUT(T) out T
 #define INOUT(T) inout T
-#define INOUT_ARRAY(T) inout T
 #define XYZ(v) (v).xyz
 #define IXYZ(v) (v).xyz
 

@@ -3,8 +3,7 @@
 // included by the CPU reference (gi_cpu.cpp) inside a struct, so that both
 // run the same algorithm step for step. Conventions that keep it both:
 // float literals carry an f suffix, conversions are written T(x), out and
-// inout parameters go through OUT(T) / INOUT(T) (INOUT_ARRAY(T) for
-// arrays, which C++ passes by pointer), and the data is reached
+// inout parameters go through OUT(T) / INOUT(T), and the data is reached
 // through accessor functions each side defines (occ_load, light_load, ...),
 // plus the uniform block P and the push constants pc.
 //
@@ -167,20 +166,6 @@ ConeSample sample_level(int l, vec3 u, int dir, vec3 apex) {
   return cs;
 }
 
-// Weight of direction i in the normalised spherical radial basis (Gaussian
-// lobes of sharpness P.fparams.w around the 16 directions; they sum to 1).
-float rbf_weight(vec3 w, int i) {
-  float lambda = P.fparams.w;
-  float sum = 0.0f;
-  float mine = 0.0f;
-  for (int j = 0; j < 16; ++j) {
-    float g = exp(lambda * (dot(w, XYZ(P.dirs[j])) - 1.0f));
-    sum += g;
-    if (j == i) mine = g;
-  }
-  return mine / sum;
-}
-
 // What one cone gathers: light of the three buffers and the sky, each
 // already multiplied by the transmittance in front of it, and the
 // transmittance where the march passed each point light's distance.
@@ -203,6 +188,8 @@ ConeResult trace_cone_range(vec3 apex, int dir, int l0, float t0, float t1) {
   r.b1 = vec3(0.0f);
   r.b2 = vec3(0.0f);
   for (int i = 0; i < 8; ++i) r.vis[i] = -1.0f;
+  float light_dist[8];
+  for (int i = 0; i < gi_lights(); ++i) light_dist[i] = length(XYZ(P.light_pos[i]) - apex);
   float T = 1.0f;
   vec3 d = XYZ(P.dirs[dir]);
   float t = t0;
@@ -223,7 +210,7 @@ ConeResult trace_cone_range(vec3 apex, int dir, int l0, float t0, float t1) {
     float dt = 0.5f * level_size(l);
     // Point lights before t + dt.
     for (int i = 0; i < gi_lights(); ++i) {
-      if (r.vis[i] < 0.0f && length(XYZ(P.light_pos[i]) - apex) < t + dt) r.vis[i] = T;
+      if (r.vis[i] < 0.0f && light_dist[i] < t + dt) r.vis[i] = T;
     }
     ConeSample cs = sample_level(l, u, dir, apex);
     float a = min(cs.alpha, 1.0f);
@@ -246,33 +233,39 @@ ConeResult trace_cone_range(vec3 apex, int dir, int l0, float t0, float t1) {
   return r;
 }
 
+// Visibility of point light j from `from`: the transmittance of the cones
+// toward it, cone_vis[dir * 8 + j] (negative for a cone not traced),
+// blended by the radial basis weights of the light's direction over the
+// cones traced.
+float light_visibility(vec3 from, int j, float cone_vis[16 * 8]) {
+  vec3 to = XYZ(P.light_pos[j]) - from;
+  vec3 w = to * inversesqrt(max(dot(to, to), 1e-12f));
+  float num = 0.0f;
+  float den = 0.0f;
+  for (int i = 0; i < 16; ++i) {
+    float v = cone_vis[i * 8 + j];
+    if (v < 0.0f) continue;
+    float g = exp(P.fparams.w * (dot(w, XYZ(P.dirs[i])) - 1.0f));
+    num += g * v;
+    den += g;
+  }
+  return den > 0.0f ? num / den : 0.0f;
+}
+
 // Irradiance of the point lights at x with normal n: the exact I cos / r^2
-// (r at least min_r), times each light's visibility, the transmittance of
-// the cones toward it blended by the radial basis weights of its direction
-// from the apex (vis_sum[i] = sum of B_j(w_i) * vis_j, weight_sum[i] = sum of
-// B_j over the cones traced). The cones give the shadows, soft as the
+// (r at least min_r), times each light's visibility from the cones traced
+// from `from` (light_visibility). The cones give the shadows, soft as the
 // cones are wide; the cosine and distance are those of a point light.
-vec3 point_light_irradiance(vec3 x, vec3 n, float min_r, float vis_sum[8], float weight_sum[8]) {
+vec3 point_light_irradiance(vec3 x, vec3 n, float min_r, vec3 from, float cone_vis[16 * 8]) {
   vec3 e = vec3(0.0f);
   for (int i = 0; i < gi_lights(); ++i) {
     vec3 to = XYZ(P.light_pos[i]) - x;
     float r2 = max(dot(to, to), min_r * min_r);
     float c = dot(n, to) * inversesqrt(max(dot(to, to), 1e-12f));
-    if (c <= 0.0f || weight_sum[i] <= 0.0f) continue;
-    e += (c / r2 * vis_sum[i] / weight_sum[i]) * XYZ(P.light_int[i]);
+    if (c <= 0.0f) continue;
+    e += (c / r2 * light_visibility(from, i, cone_vis)) * XYZ(P.light_int[i]);
   }
   return e;
-}
-
-// Adds cone dir's visibility of each light (seen from apex) to the sums.
-void add_light_visibility(vec3 apex, int dir, float vis[8], INOUT_ARRAY(float) vis_sum[8],
-                          INOUT_ARRAY(float) weight_sum[8]) {
-  for (int i = 0; i < gi_lights(); ++i) {
-    vec3 to = XYZ(P.light_pos[i]) - apex;
-    float w = rbf_weight(to * inversesqrt(max(dot(to, to), 1e-12f)), dir);
-    vis_sum[i] += w * vis[i];
-    weight_sum[i] += w;
-  }
 }
 
 // The whole cone (no end).
@@ -339,19 +332,13 @@ void kernel_update(int gid) {
   vec3 gd[16];
   vec3 gb1[16];
   float far_vis[16 * 8];
-  float vis_sum[8];
-  float weight_sum[8];
-  for (int j = 0; j < 8; ++j) {
-    vis_sum[j] = 0.0f;
-    weight_sum[j] = 0.0f;
-  }
+  float near_vis[16 * 8];  // split: per face, through the near part and then the far part
   for (int i = 0; i < 16; ++i) {
     ConeResult cr = trace_cone(apex, i, l, ts);
     src[i] = cr.src;
     gd[i] = cr.d;
     gb1[i] = cr.b1;
     for (int j = 0; j < gi_lights(); ++j) far_vis[i * 8 + j] = cr.vis[j];
-    if (!split) add_light_visibility(apex, i, cr.vis, vis_sum, weight_sum);
   }
   for (int f = 0; f < 6; ++f) {
     vec4 albedo = attr_load((s * 6 + f) * 3 + 0);
@@ -367,14 +354,11 @@ void kernel_update(int gid) {
     vec3 ed = vec3(0.0f);
     vec3 eb = vec3(0.0f);
     vec3 apex_f = apex + (0.5f * vs) * n;
-    if (split) {
-      for (int j = 0; j < 8; ++j) {
-        vis_sum[j] = 0.0f;
-        weight_sum[j] = 0.0f;
-      }
-    }
+    float light_dist[8];
+    for (int j = 0; j < gi_lights(); ++j) light_dist[j] = length(XYZ(P.light_pos[j]) - apex_f);
     for (int i = 0; i < 16; ++i) {
       float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
+      for (int j = 0; j < gi_lights(); ++j) near_vis[i * 8 + j] = -1.0f;
       if (c <= 0.0f) continue;
       if (split) {
         float t1 = ts - 0.5f * vs * c;
@@ -383,10 +367,8 @@ void kernel_update(int gid) {
         ed += c * (nr.d + nr.transmittance * gd[i]);
         eb += c * (nr.b1 + nr.transmittance * gb1[i]);
         // A light beyond the near part is seen through it and the far part.
-        for (int j = 0; j < gi_lights(); ++j) {
-          if (length(XYZ(P.light_pos[j]) - apex_f) >= t1) nr.vis[j] *= far_vis[i * 8 + j];
-        }
-        add_light_visibility(apex_f, i, nr.vis, vis_sum, weight_sum);
+        for (int j = 0; j < gi_lights(); ++j)
+          near_vis[i * 8 + j] = light_dist[j] >= t1 ? nr.vis[j] * far_vis[i * 8 + j] : nr.vis[j];
       } else {
         es += c * src[i];
         ed += c * gd[i];
@@ -394,7 +376,8 @@ void kernel_update(int gid) {
       }
     }
     vec3 rho = XYZ(albedo) / wsum;
-    vec3 lights = point_light_irradiance(apex_f, n, 0.5f * vs, vis_sum, weight_sum);
+    vec3 lights = split ? point_light_irradiance(apex_f, n, 0.5f * vs, apex_f, near_vis)
+                        : point_light_irradiance(apex_f, n, 0.5f * vs, apex, far_vis);
     light_store((s * 6 + f) * 3 + 0, vec4(emission + rho * es + (XYZ(albedo) / kPi) * lights, 0.0f));
     light_store((s * 6 + f) * 3 + 1, vec4(rho * ed, 0.0f));
     light_store((s * 6 + f) * 3 + 2, vec4(rho * eb, 0.0f));
@@ -426,22 +409,18 @@ void kernel_query(int gid) {
   float wsum = cosine_sum(n);
   vec3 e = vec3(0.0f);
   int bounces = pc.level;
-  float vis_sum[8];
-  float weight_sum[8];
-  for (int j = 0; j < 8; ++j) {
-    vis_sum[j] = 0.0f;
-    weight_sum[j] = 0.0f;
-  }
+  float cone_vis[16 * 8];
   for (int i = 0; i < 16; ++i) {
     float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
+    for (int j = 0; j < gi_lights(); ++j) cone_vis[i * 8 + j] = -1.0f;
     if (c <= 0.0f) continue;
     ConeResult cr = trace_cone(apex, i, l0, 0.5f * s);
-    add_light_visibility(apex, i, cr.vis, vis_sum, weight_sum);
+    for (int j = 0; j < gi_lights(); ++j) cone_vis[i * 8 + j] = cr.vis[j];
     vec3 l = cr.src + cr.d;
     if (bounces >= 2) l += cr.b1;
     if (bounces >= 3) l += cr.b2 + third_bounce(cr.b1, cr.b2);
     e += c * l;
   }
-  vec3 lights = point_light_irradiance(p, n, 0.5f * s, vis_sum, weight_sum);
+  vec3 lights = point_light_irradiance(p, n, 0.5f * s, apex, cone_vis);
   qout_store(q, vec4(e * (kPi / wsum) + lights, float(l0)));
 }
