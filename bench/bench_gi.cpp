@@ -270,8 +270,9 @@ void run(const Scene& s, int points, int paths) {
   }
 }
 
-// The error split by light source (sky, point light, emitter alone), each
-// with 1..3 bounces, on the CPU engine: says which term the error comes from.
+// The error split by light source (sky, point light exact and injected,
+// emitter alone), each with 1..3 bounces, on the CPU engine: says which
+// term the error comes from.
 void by_source(const Scene& s, int points, int paths) {
   std::printf("\n### %s: error by light source (cpu engine)\n", s.name.c_str());
   Result<ContourMesh> mesh = contour_world(s.world);
@@ -280,21 +281,23 @@ void by_source(const Scene& s, int points, int paths) {
   std::vector<glm::vec3> n;
   query_points(mesh.value(), s.camera, 1.5, points, p, n);
   std::printf("| source | bounces | mean rel. error | p95 rel. error | mean cone-traced | mean path-traced |\n|---|---|---|---|---|---|\n");
-  for (int src = 0; src < 3; ++src) {
+  for (int src = 0; src < 4; ++src) {
     GiLights lights;
     MaterialTable mats = s.materials;
     if (src == 0) lights.sky = s.lights.sky;
-    if (src == 1) lights.points = s.lights.points;
+    if (src == 1 || src == 3) lights.points = s.lights.points;
     if (src != 2) {
       for (VoxelMaterial& m : mats.materials) m.emission = glm::vec3(0.0f);
     }
-    bool present = src == 1 ? !lights.points.empty() : false;
+    bool present = src == 1 || src == 3 ? !lights.points.empty() : false;
     for (int i = 0; i < kGiDirections && src == 0; ++i) present = present || lum(lights.sky.amplitude[size_t(i)]) > 0;
     for (const VoxelMaterial& m : mats.materials) present = present || (src == 2 && lum(m.emission) > 0);
     if (!present) continue;
     Result<Cascades> cas = bench_cascades(s, mats);
     if (!cas.ok()) return;
-    std::unique_ptr<GiEngine> g = make_cpu_gi();
+    GiConfig gc;
+    gc.light_volume = src == 3;
+    std::unique_ptr<GiEngine> g = make_cpu_gi(gc);
     if (!g->load(cas.value(), lights).ok() || !g->update_all(3).ok()) return;
     Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), mats, lights);
     if (!pt.ok()) return;
@@ -307,7 +310,7 @@ void by_source(const Scene& s, int points, int paths) {
       const Stats st = rel_error(e, ref);
       double mg = 0, mr = 0;
       for (size_t i = 0; i < p.size(); ++i) mg += lum(e[i]) / double(p.size()), mr += lum(ref[i]) / double(p.size());
-      const char* names[] = {"sky", "point light", "emission"};
+      const char* names[] = {"sky", "point light (exact)", "emission", "point light (injected volume)"};
       std::printf("| %s | %d | %.1f%% | %.1f%% | %.3f | %.3f |\n", names[src], b, 100 * st.mean, 100 * st.p95, mg, mr);
     }
   }
@@ -321,6 +324,7 @@ int main(int argc, char** argv) {
   std::printf("# bench_gi: cone-traced GI (Vulkan engine rows name their device; llvmpipe = Mesa's lavapipe on the CPU) vs path-traced reference\n");
   if (argc > 3 && std::string(argv[3]) == "sources") {
     by_source(cornell(), points, paths);
+    by_source(landscape(), points, paths);
     by_source(furnace(), points, paths);
     return 0;
   }

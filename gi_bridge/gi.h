@@ -40,14 +40,25 @@
 // Sky: 16 spherical radial basis lobes on the directions, normalised to a
 // partition of unity: L_sky(w) = sum_i a_i B_i(w), B_i = exp(k (w . d_i - 1))
 // / sum_j exp(k (w . d_j - 1)). A cone i that escapes gets a_i.
-// Point lights (at most kGiMaxPointLights): radiant intensity I
-// [radiance * m^2]. Their irradiance at a point (or voxel face) with normal
-// n is the exact I max(0, n . w) / r^2 times a visibility: the
-// transmittance each cone had gathered where its march passed the light's
-// distance, blended by the lights' radial basis weights B_i(w) over the
-// cones traced. So an unoccluded light is exact and the cones give soft
-// shadows with the occlusion built so far. (The talk injects lights into a
-// cascaded volume that the cones read; this is a list, not yet that.)
+// Point lights: radiant intensity I [radiance * m^2]. Two ways, chosen by
+// GiConfig::light_volume:
+//  - exact (default; at most kGiMaxPointLights): their irradiance at a
+//    point (or voxel face) with normal n is the exact I max(0, n . w) / r^2
+//    times a visibility: the transmittance each cone had gathered where its
+//    march passed the light's distance, blended by the lights' radial basis
+//    weights B_i(w) over the cones traced. An unoccluded light is exact and
+//    the cones give soft shadows with the occlusion built so far.
+//  - injected (the talk's method; at most kGiMaxInjectedPointLights): each
+//    light is splatted into a light volume cascaded like the G-buffer, at
+//    every level, over the 8 voxels around it by trilinear weights, as an
+//    emission density I w / s^3 (s the level's voxel size): the trilinear
+//    reconstruction integrates to I over space. A cone marching through it
+//    adds T * density * step (T the transmittance built so far), so over
+//    all directions the cones gather I / r^2 on average; per direction it
+//    varies with where the light falls between the cones' axes, and a
+//    light nearer than a voxel to a surface is blurred over it. The march
+//    costs one more trilinear lookup per step whatever the number of
+//    lights; splatting costs 8 writes per light and level (on the host).
 // Faces behind a surface: the voxelizer propagates a surface's face to the
 // solid voxel behind it (voxelize.h); that face shows the surface's light
 // (GiLayout::face_src), so a cone entering a wall, which samples both
@@ -73,7 +84,8 @@
 namespace ldc {
 
 inline constexpr int kGiDirections = 16;
-inline constexpr int kGiMaxPointLights = 8;
+inline constexpr int kGiMaxPointLights = 8;          // exact point lights
+inline constexpr int kGiMaxInjectedPointLights = 65536;  // GiConfig::light_volume
 inline constexpr int kGiMaxLevels = 16;
 
 // The 16 directions (see the header comment).
@@ -101,9 +113,9 @@ struct PointLight {
 
 struct GiLights {
   SkyLight sky;
-  std::vector<PointLight> points;  // [Limit: size <= kGiMaxPointLights]
+  // [Limit: size <= kGiMaxPointLights, or kGiMaxInjectedPointLights with GiConfig::light_volume]
+  std::vector<PointLight> points;
 };
-Status check_gi_lights(const GiLights& lights);
 
 struct GiConfig {
   // Read the 16-direction precombined light/opacity buffers (one lookup per
@@ -134,10 +146,17 @@ struct GiConfig {
   // Where the far part starts. [Units: voxels of the updated level] [Limit: 1 .. 16] [Default: 2.5 (the
   // talk: about a metre at its 0.4 m voxels)]
   float near_far_split = 2.5f;
+  // Point lights injected into a cascaded light volume that the cones
+  // gather (the talk's method: any number of lights at the same cost per
+  // cone step) instead of evaluated exactly per light (see the header
+  // comment for both). [Default: off (exact)]
+  bool light_volume = false;
   // Query apex offset along the normal. [Units: voxels of the start level] [Limit: 0 .. 4] [Default: 1]
   float query_offset = 1.0f;
 };
 Status check_gi_config(const GiConfig& config);
+// Checks the lights against the limits of `config`'s point light mode.
+Status check_gi_lights(const GiLights& lights, const GiConfig& config);
 
 // What a frame or a level update did.
 struct GiTimings {
@@ -161,6 +180,10 @@ class GiEngine {
   // Takes the cascades' packed G-buffer (Cascades::pack) and surface voxels
   // of every valid level, and the lights; clears the light buffers.
   virtual Status load(const Cascades& cascades, const GiLights& lights) = 0;
+  // Replaces the sky and point lights of a loaded scene (a game moving its
+  // lights) without re-uploading the G-buffer. The light buffers keep their
+  // values and follow over the next updates (3 passes settle a static scene).
+  virtual Status set_lights(const GiLights& lights) = 0;
   // One frame: the scheduled level when staggered, otherwise every level.
   virtual Result<GiTimings> frame() = 0;
   // One lighting pass of one level (from the previous frame's buffers).

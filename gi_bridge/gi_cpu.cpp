@@ -28,7 +28,7 @@ struct Buffers {
   std::vector<float> occ, alpha;
   std::vector<int32_t> vmap, fsrc;
   std::vector<ivec4> surf_pos;
-  std::vector<vec4> attr, light_prev, light_next, pre, qin, qout;
+  std::vector<vec4> attr, light_prev, light_next, pre, qin, qout, plight;
 };
 
 #define GI_CONST static constexpr
@@ -57,6 +57,7 @@ struct Kernels {
   void pre_store(int i, vec4 v) const { b->pre[size_t(i)] = v; }
   vec4 qin_load(int i) const { return b->qin[size_t(i)]; }
   void qout_store(int i, vec4 v) const { b->qout[size_t(i)] = v; }
+  vec4 plight_load(int i) const { return b->plight[size_t(i)]; }
 
 #include "gi_bridge/shaders/gi_common.glsl"
 };
@@ -84,6 +85,12 @@ class CpuGi final : public GiEngineBase {
     b_.light_prev.assign(layout.surfaces() * 18, vec4(0.0f));
     b_.light_next = b_.light_prev;
     b_.pre.assign(layout.surfaces() * 48, vec4(0.0f));
+    return upload_lights(layout);
+  }
+
+  Status upload_lights(const GiLayout& layout) override {
+    params_ = layout.params;
+    b_.plight = layout.light_volume;
     return {};
   }
 

@@ -59,7 +59,7 @@ bool finite_nonneg(const glm::vec3& v) {
 Status bad(const std::string& what) { return Status(ErrorCode::kInvalidArgument, what); }
 }  // namespace
 
-Status check_gi_lights(const GiLights& lights) {
+Status check_gi_lights(const GiLights& lights, const GiConfig& config) {
   for (int i = 0; i < kGiDirections; ++i) {
     if (!finite_nonneg(lights.sky.amplitude[size_t(i)]))
       return bad("sky amplitude " + std::to_string(i) + " must be finite and >= 0");
@@ -69,9 +69,10 @@ Status check_gi_lights(const GiLights& lights) {
     s << "sky sharpness " << lights.sky.sharpness << " must be in 0.5 .. 64";
     return bad(s.str());
   }
-  if (lights.points.size() > size_t(kGiMaxPointLights))
-    return bad(std::to_string(lights.points.size()) + " point lights: at most " +
-               std::to_string(kGiMaxPointLights));
+  const int max_points = config.light_volume ? kGiMaxInjectedPointLights : kGiMaxPointLights;
+  if (lights.points.size() > size_t(max_points))
+    return bad(std::to_string(lights.points.size()) + " point lights: at most " + std::to_string(max_points) +
+               (config.light_volume ? " injected" : " exact (GiConfig::light_volume takes more)"));
   for (size_t i = 0; i < lights.points.size(); ++i) {
     const PointLight& p = lights.points[i];
     if (!finite_nonneg(p.intensity) || !detail::is_finite(glm::dvec3(p.position)))
@@ -103,22 +104,72 @@ namespace detail {
 
 namespace {
 
+// The talk's point light injection (it used a geometry shader; here the
+// host splats, 8 writes per light and level): each light, at every level,
+// over the 8 voxels around it by trilinear weights w, as an emission
+// density I w / s^3 [radiance / m]. The cones' trilinear reconstruction of
+// those values integrates to I over space, so their march (which adds
+// T * density * step) gathers I / r^2 over all directions on average.
+// The weights are moved toward open voxels (scaled by 1 - the voxel's mean
+// face opacity, renormalised): light put into a solid voxel is never seen,
+// and a light a few centimetres from a wall would lose up to half of it.
+// Voxels outside a level get nothing: a cone there reads a coarser level.
+void inject_point_lights(const std::vector<PointLight>& lights, GiLayout& out) {
+  const int n = out.n;
+  for (const PointLight& light : lights) {
+    for (int l = 0; l < out.k; ++l) {
+      const double size = double(out.params.fparams.x) * double(1 << l);
+      const glm::dvec3 u = (light.position - out.origin) / size - glm::dvec3(glm::ivec3(out.params.lo[l])) - 0.5;
+      const glm::ivec3 c0(glm::floor(u));
+      const glm::dvec3 f = u - glm::dvec3(c0);
+      const glm::vec3 density = light.intensity / float(size * size * size);
+      double w[8] = {}, sum = 0.0, inside = 0.0;
+      size_t voxel[8] = {};
+      for (int k = 0; k < 8; ++k) {
+        const glm::ivec3 o(k & 1, (k >> 1) & 1, (k >> 2) & 1);
+        const glm::ivec3 c = c0 + o;
+        if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, glm::ivec3(n)))) continue;
+        voxel[k] = size_t(l) * size_t(n) * n * n + (size_t(c.z) * n + size_t(c.y)) * n + size_t(c.x);
+        double occ = 0.0;
+        for (int face = 0; face < 6; ++face) occ += out.occ[voxel[k] * 6 + size_t(face)] / 6.0;
+        const double tri = (o.x ? f.x : 1.0 - f.x) * (o.y ? f.y : 1.0 - f.y) * (o.z ? f.z : 1.0 - f.z);
+        w[k] = tri * (1.0 - occ);
+        inside += tri;
+        sum += w[k];
+      }
+      if (sum <= 1e-6) continue;  // outside the level, or buried
+      for (int k = 0; k < 8; ++k) {
+        if (w[k] > 0.0) out.light_volume[voxel[k]] += glm::vec4(density * float(w[k] * inside / sum), 0.0f);
+      }
+    }
+  }
+}
+
+// The sky and the point lights: exact lights go in the uniform block, and
+// injected ones are splatted into the light volume instead.
+void fill_light_params(const GiLights& lights, const GiConfig& config, GiLayout& out) {
+  GiParams& p = out.params;
+  for (int i = 0; i < kGiDirections; ++i) p.sky[i] = glm::vec4(lights.sky.amplitude[size_t(i)], 0.0f);
+  const size_t exact = config.light_volume ? 0 : lights.points.size();
+  for (size_t i = 0; i < size_t(kGiMaxPointLights); ++i) {
+    p.light_pos[i] = i < exact ? glm::vec4(glm::vec3(lights.points[i].position - out.origin), 1.0f) : glm::vec4(0.0f);
+    p.light_int[i] = i < exact ? glm::vec4(lights.points[i].intensity, 0.0f) : glm::vec4(0.0f);
+  }
+  p.fparams.w = lights.sky.sharpness;
+  p.iparams.w = int(exact);
+  out.light_volume.assign(config.light_volume ? out.voxels() : 0, glm::vec4(0.0f));
+  if (config.light_volume) inject_point_lights(lights.points, out);
+}
+
 void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfig& config, GiLayout& out) {
   GiParams& p = out.params;
-  for (int i = 0; i < kGiDirections; ++i) {
-    p.dirs[i] = glm::vec4(gi_directions()[size_t(i)], 0.0f);
-    p.sky[i] = glm::vec4(lights.sky.amplitude[size_t(i)], 0.0f);
-  }
-  for (size_t i = 0; i < lights.points.size(); ++i) {
-    p.light_pos[i] = glm::vec4(glm::vec3(lights.points[i].position - out.origin), 1.0f);
-    p.light_int[i] = glm::vec4(lights.points[i].intensity, 0.0f);
-  }
-  p.fparams = glm::vec4(float(cascades.voxel_size(0)), config.third_bounce_boost, config.query_offset,
-                        lights.sky.sharpness);
-  p.iparams = glm::ivec4(out.n, out.k, (config.precombined ? 1 : 0) | (config.near_far ? 2 : 0),
-                         int(lights.points.size()));
+  for (int i = 0; i < kGiDirections; ++i) p.dirs[i] = glm::vec4(gi_directions()[size_t(i)], 0.0f);
+  p.fparams = glm::vec4(float(cascades.voxel_size(0)), config.third_bounce_boost, config.query_offset, 0.0f);
+  p.iparams = glm::ivec4(out.n, out.k,
+                         (config.precombined ? 1 : 0) | (config.near_far ? 2 : 0) | (config.light_volume ? 4 : 0), 0);
   p.fparams2 = glm::vec4(config.near_far_split, 0.0f, 0.0f, 0.0f);
   for (int l = 0; l < out.k; ++l) p.lo[l] = glm::ivec4(cascades.level_box(l).lo, 0);
+  fill_light_params(lights, config, out);
 }
 
 bool s_is_updated(const GiLayout& out, int l, int32_t s) {
@@ -205,7 +256,7 @@ void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
 
 Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& lights, const GiConfig& config) {
   if (Status s = check_gi_config(config); !s.ok()) return s;
-  if (Status s = check_gi_lights(lights); !s.ok()) return s;
+  if (Status s = check_gi_lights(lights, config); !s.ok()) return s;
   GiLayout out;
   out.n = cascades.resolution();
   out.k = cascades.levels();
@@ -216,7 +267,6 @@ Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& light
                                             "^3 voxels are too many (at most 2^31 / 16 voxels in all)");
   }
   out.origin = cascades.origin();
-  fill_params(cascades, lights, config, out);
   PackedGBuffer packed;
   cascades.pack(&packed);
   out.occ.assign(out.voxels() * 6, 0.0f);
@@ -225,6 +275,7 @@ Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& light
   out.level_count.assign(size_t(out.k), 0);
   out.level_shadow.assign(size_t(out.k), 0);
   for (int l = 0; l < out.k; ++l) add_level(packed, l, cascades.level_valid(l), out);
+  fill_params(cascades, lights, config, out);  // after the opacities: injection reads them
   return out;
 }
 
@@ -239,6 +290,13 @@ Status GiEngineBase::load(const Cascades& cascades, const GiLights& lights) {
   loaded_ = true;
   frame_ = 0;
   return {};
+}
+
+Status GiEngineBase::set_lights(const GiLights& lights) {
+  if (!loaded_) return Status(ErrorCode::kInvalidArgument, "gi: load() the cascades first");
+  if (Status s = check_gi_lights(lights, config_); !s.ok()) return s;
+  fill_light_params(lights, config_, layout_);
+  return upload_lights(layout_);
 }
 
 Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {

@@ -25,7 +25,7 @@ const uint32_t kSpvQuery[] =
 #include "gi_kernel4.spv.inc"
     ;
 
-constexpr int kBindings = 12;
+constexpr int kBindings = 13;
 constexpr int kGroup = 64;         // local_size_x
 constexpr int kMaxGroups = 65535;  // per dispatch (the guaranteed minimum)
 
@@ -50,6 +50,7 @@ class VulkanGi final : public GiEngineBase {
 
  protected:
   Status upload(const GiLayout& layout) override;
+  Status upload_lights(const GiLayout& layout) override;
   Status run(GiKernel kernel, int first, int count, int level) override;
   Status commit(int first, int count) override;
   Status set_queries(const std::vector<glm::vec4>& qin) override;
@@ -283,8 +284,17 @@ Status VulkanGi::upload(const GiLayout& layout) {
   if (st.ok() && !buffers_[9].buffer) st = make_buffer(9, 32, nullptr);
   if (st.ok() && !buffers_[10].buffer) st = make_buffer(10, 16, nullptr);
   if (st.ok()) st = make_buffer(11, bytes(layout.face_src), layout.face_src.data());
+  if (st.ok()) st = make_buffer(12, bytes(layout.light_volume), layout.light_volume.data());
   if (!st.ok()) return st;
   write_descriptors();
+  return {};
+}
+
+Status VulkanGi::upload_lights(const GiLayout& layout) {
+  // Every run waits for its fence, so no kernel is reading these now.
+  std::memcpy(buffers_[0].mapped, &layout.params, sizeof(GiParams));
+  if (bytes(layout.light_volume) > buffers_[12].size) return Status(ErrorCode::kInternal, "gi: light volume grew");
+  std::memcpy(buffers_[12].mapped, layout.light_volume.data(), size_t(bytes(layout.light_volume)));
   return {};
 }
 

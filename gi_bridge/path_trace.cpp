@@ -28,7 +28,10 @@ PathTracer::~PathTracer() = default;
 
 Result<std::unique_ptr<PathTracer>> PathTracer::create(const ContourMesh& mesh, const MaterialTable& materials,
                                                        const GiLights& lights) {
-  if (Status s = check_gi_lights(lights); !s.ok()) return s;
+  // Each light is one shadow ray per vertex: take as many as either GI mode.
+  GiConfig any_lights;
+  any_lights.light_volume = true;
+  if (Status s = check_gi_lights(lights, any_lights); !s.ok()) return s;
   if (mesh.triangles.empty()) return Status(ErrorCode::kInvalidArgument, "path tracer: the mesh has no triangles");
   auto impl = std::make_unique<Impl>();
   impl->device = rtcNewDevice(nullptr);

@@ -32,6 +32,8 @@ struct GiArgs {
   double voxel_size = 0.0;  // 0: 2 h
   float exposure = 1.0f;
   bool reference = false;
+  std::vector<std::string> lights;  // "x,y,z,I" or "x,y,z,r,g,b"
+  bool light_volume = false;
 };
 
 const char* const kGiHelp = R"(Sky: a gradient (zenith 1.0/1.2/1.6, horizon 1.4, ground 0.3) in the 16 lobes; emission
@@ -40,11 +42,33 @@ every level (3 give direct light and two bounces). --engine vulkan falls back to
 reference when no Vulkan device exists. Colour: albedo / pi * irradiance + emission,
 exposure, x / (1 + x), gamma 2.2. --reference path-traces the same view on the
 contoured mesh (--samples paths per pixel) and writes it to the right of the GI image.
+--light x,y,z,I (or x,y,z,r,g,b) adds a point light of intensity I at a world point
+(irradiance I / r^2 facing it); at most 8, or 65536 with --light-volume, which injects
+them into a cascaded light volume as the talk does (less exact, see docs/gi.md).
 )";
 
-GiLights default_lights() {
+// The default sky and the --light point lights.
+Result<GiLights> parse_lights(const GiArgs& a) {
   GiLights l;
   l.sky = SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f));
+  for (const std::string& text : a.lights) {
+    std::vector<double> v;
+    bool numbers = true;
+    std::istringstream in(text);
+    std::string item;
+    while (std::getline(in, item, ',')) {
+      char* end = nullptr;
+      v.push_back(std::strtod(item.c_str(), &end));
+      numbers = numbers && !item.empty() && *end == '\0' && std::isfinite(v.back());
+    }
+    if (!numbers || (v.size() != 4 && v.size() != 6))
+      return Status(ErrorCode::kInvalidArgument, "--light " + text + ": want x,y,z,I or x,y,z,r,g,b (finite numbers)");
+    const glm::vec3 intensity = v.size() == 4 ? glm::vec3(float(v[3])) : glm::vec3(float(v[3]), float(v[4]), float(v[5]));
+    l.points.push_back({glm::dvec3(v[0], v[1], v[2]), intensity});
+  }
+  GiConfig config;
+  config.light_volume = a.light_volume;
+  if (Status s = check_gi_lights(l, config); !s.ok()) return s;
   return l;
 }
 
@@ -54,21 +78,21 @@ uint8_t tone(float v, float exposure) {
   return uint8_t(std::lround(255.0f * std::pow(std::clamp(v, 0.0f, 1.0f), 1.0f / 2.2f)));
 }
 
-Result<std::unique_ptr<GiEngine>> make_engine(const std::string& name, std::string* device) {
+Result<std::unique_ptr<GiEngine>> make_engine(const std::string& name, const GiConfig& config, std::string* device) {
   if (name == "cpu") {
     *device = "cpu reference";
-    return make_cpu_gi();
+    return make_cpu_gi(config);
   }
   if (name != "vulkan") return Status(ErrorCode::kInvalidArgument, "--engine " + name + ": use vulkan or cpu");
 #ifdef LDC_HAVE_VULKAN
-  Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi({}, device);
+  Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi(config, device);
   if (gi.ok()) return gi;
   std::fprintf(stderr, "gi: %s; using the CPU reference\n", gi.status().message().c_str());
 #else
   std::fprintf(stderr, "gi: built without Vulkan (LDC_WITH_VULKAN off); using the CPU reference\n");
 #endif
   *device = "cpu reference";
-  return make_cpu_gi();
+  return make_cpu_gi(config);
 }
 
 using Pixels = std::vector<glm::vec3>;
@@ -152,6 +176,11 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
 #ifndef LDC_HAVE_GI_REFERENCE
   if (a.reference) return fail("gi", "--reference: built without Embree 3 (the path tracer's ray caster)");
 #endif
+  Result<GiLights> parsed_lights = parse_lights(a);
+  if (!parsed_lights.ok()) return fail("gi", parsed_lights.status());
+  const GiLights& lights = parsed_lights.value();
+  GiConfig gi_config;
+  gi_config.light_volume = a.light_volume;
   ProgressBar bar(!common.quiet);
   Result<World> w = load_world(a.world, {}, bar.context());
   bar.finish();
@@ -169,9 +198,8 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
   if (Status s = cas.value().update_all(world, cam.value().position()); !s.ok()) return fail("gi", s);
   const double vox_s = t_vox.seconds();
   std::string device;
-  Result<std::unique_ptr<GiEngine>> gi = make_engine(a.engine, &device);
+  Result<std::unique_ptr<GiEngine>> gi = make_engine(a.engine, gi_config, &device);
   if (!gi.ok()) return fail("gi", gi.status());
-  const GiLights lights = default_lights();
   if (Status s = gi.value()->load(cas.value(), lights); !s.ok()) return fail("gi", s);
   Result<GiTimings> upd = gi.value()->update_all(a.passes);
   if (!upd.ok()) return fail("gi", upd.status());
@@ -209,6 +237,7 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
                      {"voxel_size", cc.voxel_size},
                      {"surface_voxels", upd.value().surface_voxels / size_t(a.passes)},
                      {"passes", a.passes},
+                     {"point_lights", {{"count", lights.points.size()}, {"mode", a.light_volume ? "injected volume" : "exact"}}},
                      {"seconds", {{"voxelize", vox_s}, {"lighting", upd.value().seconds}, {"image", img_s}}},
                      {"image", {{"width", wdt}, {"height", hgt}, {"bounces", a.bounces}}},
                      {"output", a.output}};
@@ -245,6 +274,8 @@ void add_gi_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--exposure", args->exposure, "Exposure before tone mapping")->capture_default_str();
   cmd->add_flag("--reference", args->reference, "Also path-trace the view (Embree) and put it on the right");
   cmd->add_option("--samples", args->samples, "Paths per pixel of --reference")->capture_default_str();
+  cmd->add_option("--light", args->lights, "Point light x,y,z,I or x,y,z,r,g,b (repeatable)");
+  cmd->add_flag("--light-volume", args->light_volume, "Inject the point lights into a cascaded volume (the talk's method)");
   cmd->footer(kGiHelp);
   cmd->callback([args, &common] {
     int code = run_gi(*args, common);

@@ -19,7 +19,7 @@ struct GiParams {
   glm::vec4 light_pos[kGiMaxPointLights];
   glm::vec4 light_int[kGiMaxPointLights];
   glm::vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset, w RBF sharpness
-  glm::ivec4 iparams;  // x N, y K, z flags, w point lights
+  glm::ivec4 iparams;  // x N, y K, z flags, w exact point lights
   glm::vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
   glm::ivec4 lo[kGiMaxLevels];
 };
@@ -43,6 +43,7 @@ struct GiLayout {
   std::vector<glm::ivec4> surf_pos;   // S: local xyz, level
   std::vector<glm::vec4> attr;        // S * 18
   std::vector<int32_t> face_src;      // S * 6: light slot (s * 6 + face) a face shows, or -1
+  std::vector<glm::vec4> light_volume;  // K N^3 injected point lights (GiConfig::light_volume), else empty
   // Per level the entries start at level_first: level_count surface voxels
   // (updated), then level_shadow voxels that only show their neighbours'
   // light on propagated faces (precombined, never updated).
@@ -58,6 +59,7 @@ class GiEngineBase : public GiEngine {
  public:
   explicit GiEngineBase(const GiConfig& config) : config_(config) {}
   Status load(const Cascades& cascades, const GiLights& lights) override;
+  Status set_lights(const GiLights& lights) override;
   Result<GiTimings> frame() override;
   Result<GiTimings> update_level(int level) override;
   Result<GiTimings> update_all(int passes) override;
@@ -68,6 +70,8 @@ class GiEngineBase : public GiEngine {
  protected:
   // Allocates and fills every buffer from the layout; light, pre and alpha zeroed.
   virtual Status upload(const GiLayout& layout) = 0;
+  // Replaces the uniform block and the light volume (set_lights).
+  virtual Status upload_lights(const GiLayout& layout) = 0;
   // Runs kernel over `count` items from `first` with pc.level = level.
   virtual Status run(GiKernel kernel, int first, int count, int level) = 0;
   // Copies light_next to light_prev for surface voxels [first, first + count).

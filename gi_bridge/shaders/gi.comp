@@ -15,7 +15,7 @@ layout(std140, binding = 0) uniform Params {
   vec4 light_pos[8];
   vec4 light_int[8];
   vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset (voxels), w RBF sharpness
-  ivec4 iparams;  // x N, y K, z flags, w point lights
+  ivec4 iparams;  // x N, y K, z flags, w exact point lights
   vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
   ivec4 lo[16];
 } P;
@@ -38,6 +38,7 @@ layout(std430, binding = 8) buffer Pre { vec4 v[]; } pre_buf;
 layout(std430, binding = 9) readonly buffer QIn { vec4 v[]; } qin_buf;
 layout(std430, binding = 10) writeonly buffer QOut { vec4 v[]; } qout_buf;
 layout(std430, binding = 11) readonly buffer FSrc { int v[]; } fsrc_buf;
+layout(std430, binding = 12) readonly buffer PLight { vec4 v[]; } plight_buf;
 
 float occ_load(int i) { return occ_buf.v[i]; }
 float alpha_load(int i) { return alpha_buf.v[i]; }
@@ -52,6 +53,7 @@ vec4 pre_load(int i) { return pre_buf.v[i]; }
 void pre_store(int i, vec4 v) { pre_buf.v[i] = v; }
 vec4 qin_load(int i) { return qin_buf.v[i]; }
 void qout_store(int i, vec4 v) { qout_buf.v[i] = v; }
+vec4 plight_load(int i) { return plight_buf.v[i]; }
 
 #include "gi_common.glsl"
 

@@ -18,6 +18,7 @@
 //                                     the neighbour's it was propagated from), -1 none
 //   light:  (s * 6 + face) * 3 + ch       ch 0 direct (D), 1 bounce (B1), 2 bounce 2 (B2)
 //   pre:    (s * 16 + dir) * 3 + ch       light of ch seen along dir, premultiplied by opacity
+//   plight: voxel                         injected point lights' emission density (kFlagLightVolume)
 
 // Cone half-angle of the 16 cones: solid angle 4 pi / 16 = pi / 4, so
 // cos = 7/8 and tan = sqrt(15) / 7.
@@ -26,6 +27,7 @@ GI_CONST float kConeSolidAngle = 0.7853981634f;
 GI_CONST float kPi = 3.1415926536f;
 GI_CONST int kFlagPrecombined = 1;
 GI_CONST int kFlagNearFar = 2;
+GI_CONST int kFlagLightVolume = 4;
 GI_CONST int kMaxSteps = 160;
 
 int gi_n() { return P.iparams.x; }
@@ -149,28 +151,45 @@ bool level_coords(int l, vec3 p, OUT(vec3) u) {
   return u.x >= 0.0f && u.y >= 0.0f && u.z >= 0.0f && u.x <= hi && u.y <= hi && u.z <= hi;
 }
 
+// Trilinear corner k (0..7) of the cell holding level coordinates u: its
+// offset from the cell's low corner c0, and its weight.
+ivec3 corner_offset(int k) { return ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1); }
+ivec3 cell_low(vec3 u) { return min(ivec3(floor(u)), ivec3(gi_n() - 2)); }
+float corner_weight(vec3 f, ivec3 o) {
+  return (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) * (o.z == 1 ? f.z : 1.0f - f.z);
+}
+
 ConeSample sample_level(int l, vec3 u, int dir, vec3 apex) {
   ConeSample cs;
   cs.alpha = 0.0f;
   cs.d = vec3(0.0f);
   cs.b1 = vec3(0.0f);
   cs.b2 = vec3(0.0f);
-  int hi = gi_n() - 1;
-  ivec3 c0 = min(ivec3(floor(u)), ivec3(hi - 1));
+  ivec3 c0 = cell_low(u);
   vec3 f = u - vec3(c0);
   for (int k = 0; k < 8; ++k) {
-    ivec3 o = ivec3(k & 1, (k >> 1) & 1, (k >> 2) & 1);
-    float w = (o.x == 1 ? f.x : 1.0f - f.x) * (o.y == 1 ? f.y : 1.0f - f.y) * (o.z == 1 ? f.z : 1.0f - f.z);
-    if (w > 0.0f) sample_corner(l, c0 + o, dir, w, apex, cs);
+    float w = corner_weight(f, corner_offset(k));
+    if (w > 0.0f) sample_corner(l, c0 + corner_offset(k), dir, w, apex, cs);
   }
   return cs;
 }
 
-// What one cone gathers: light of the three buffers and the sky, each
-// already multiplied by the transmittance in front of it, and the
-// transmittance where the march passed each point light's distance.
+// Injected point lights (kFlagLightVolume): the light volume's emission
+// density [radiance / m] at level coordinates u, trilinear.
+vec3 sample_light_volume(int l, vec3 u) {
+  ivec3 c0 = cell_low(u);
+  vec3 f = u - vec3(c0);
+  vec3 r = vec3(0.0f);
+  for (int k = 0; k < 8; ++k) r += corner_weight(f, corner_offset(k)) * XYZ(plight_load(voxel_index(l, c0 + corner_offset(k))));
+  return r;
+}
+
+// What one cone gathers: light of the three buffers and of the direct
+// sources, each already multiplied by the transmittance in front of it,
+// and the transmittance where the march passed each exact point light's
+// distance.
 struct ConeResult {
-  vec3 src;  // sky
+  vec3 src;  // sky and injected point lights
   vec3 d;
   vec3 b1;
   vec3 b2;
@@ -181,7 +200,11 @@ struct ConeResult {
 // Marches the cone along dir from apex (relative to the lattice origin)
 // starting at distance t0 at level l0 or coarser; records the occlusion
 // gathered so far where the march passes each point light's distance.
-ConeResult trace_cone_range(vec3 apex, int dir, int l0, float t0, float t1) {
+// `lit`: the point being lit. Injected light at p reaches it as
+// 1 / |p - lit|^2, not as the cone's 1 / t^2 from its apex: a query's apex
+// sits a voxel above the surface, and without the correction a light 1.75
+// voxels above a plane gave 1.7 times its irradiance.
+ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float t1) {
   ConeResult r;
   r.src = vec3(0.0f);
   r.d = vec3(0.0f);
@@ -211,6 +234,12 @@ ConeResult trace_cone_range(vec3 apex, int dir, int l0, float t0, float t1) {
     // Point lights before t + dt.
     for (int i = 0; i < gi_lights(); ++i) {
       if (r.vis[i] < 0.0f && light_dist[i] < t + dt) r.vis[i] = T;
+    }
+    // Injected lights in this step, behind the occlusion in front of it.
+    if ((gi_flags() & kFlagLightVolume) != 0) {
+      vec3 to = p - lit;
+      float g = t * t / max(dot(to, to), t * t);
+      r.src += (T * dt * g) * sample_light_volume(l, u);
     }
     ConeSample cs = sample_level(l, u, dir, apex);
     float a = min(cs.alpha, 1.0f);
@@ -269,7 +298,10 @@ vec3 point_light_irradiance(vec3 x, vec3 n, float min_r, vec3 from, float cone_v
 }
 
 // The whole cone (no end).
-ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) { return trace_cone_range(apex, dir, l0, t0, 1e30f); }
+ConeResult trace_cone_range(vec3 apex, int dir, int l0, float t0, float t1) {
+  return trace_cone_lit(apex, apex, dir, l0, t0, t1);
+}
+ConeResult trace_cone(vec3 apex, int dir, int l0, float t0) { return trace_cone_lit(apex, apex, dir, l0, t0, 1e30f); }
 
 // Cosine weights of the 16 directions for normal n, normalised so that a
 // uniform radiance L gives irradiance pi L exactly; returns their sum.
@@ -414,7 +446,7 @@ void kernel_query(int gid) {
     float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
     for (int j = 0; j < gi_lights(); ++j) cone_vis[i * 8 + j] = -1.0f;
     if (c <= 0.0f) continue;
-    ConeResult cr = trace_cone(apex, i, l0, 0.5f * s);
+    ConeResult cr = trace_cone_lit(apex, p, i, l0, 0.5f * s, 1e30f);
     for (int j = 0; j < gi_lights(); ++j) cone_vis[i * 8 + j] = cr.vis[j];
     vec3 l = cr.src + cr.d;
     if (bounces >= 2) l += cr.b1;

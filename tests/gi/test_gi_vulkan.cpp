@@ -56,13 +56,17 @@ Scene lit_room() {
   return {std::move(w), std::move(c), std::move(l)};
 }
 
-void expect_engines_agree(const GiConfig& config, int passes) {
+// via_set_lights: load with no light, then set_lights(the scene's).
+void expect_engines_agree(const GiConfig& config, int passes, bool via_set_lights = false) {
   auto gpu = vulkan_or_skip(config);
   if (!gpu) GTEST_SKIP() << "no Vulkan device";
   const Scene scene = lit_room();
   auto cpu = make_cpu_gi(config);
   for (GiEngine* g : {gpu.get(), cpu.get()}) {
-    ASSERT_TRUE(g->load(scene.cascades, scene.lights).ok());
+    ASSERT_TRUE(g->load(scene.cascades, via_set_lights ? GiLights{} : scene.lights).ok());
+    if (via_set_lights) {
+      ASSERT_TRUE(g->set_lights(scene.lights).ok());
+    }
     ASSERT_TRUE(g->update_all(passes).ok());
   }
   Result<GiRadiance> rg = gpu->radiance(), rc = cpu->radiance();
@@ -112,6 +116,19 @@ TEST(GiVulkan, MatchesTheCpuReferenceWithNearFarSplitCones) {
   c.precombined = false;
   c.near_far_split = 4.0f;
   expect_engines_agree(c, 2);
+}
+
+TEST(GiVulkan, MatchesTheCpuReferenceWithInjectedPointLights) {
+  GiConfig c;
+  c.light_volume = true;
+  expect_engines_agree(c, 3);
+}
+
+TEST(GiVulkan, MatchesTheCpuReferenceAfterSetLights) {
+  expect_engines_agree(GiConfig{}, 3, true);
+  GiConfig c;
+  c.light_volume = true;
+  expect_engines_agree(c, 3, true);
 }
 
 TEST(GiVulkan, ClosedRoomIsBlackInside) {
