@@ -44,10 +44,13 @@
 // GiConfig::light_volume:
 //  - exact (default; at most kGiMaxPointLights): their irradiance at a
 //    point (or voxel face) with normal n is the exact I max(0, n . w) / r^2
-//    times a visibility: the transmittance each cone had gathered where its
-//    march passed the light's distance, blended by the lights' radial basis
-//    weights B_i(w) over the cones traced. An unoccluded light is exact and
-//    the cones give soft shadows with the occlusion built so far.
+//    times a visibility: the transmittance of a narrow shadow cone (half-
+//    angle atan 0.1) marched through the cascades toward the light, opacity
+//    only. An unoccluded light is exact; shadows are as soft as the
+//    cascades' voxels at the distance. (Blending the 16 cones'
+//    transmittances by the light's direction gave a mean error of 42% on
+//    the Cornell box's light instead of 30%, but 10% instead of 16% in the
+//    landscape's cave: see docs/benchmarks.md.)
 //  - injected (the talk's method; at most kGiMaxInjectedPointLights): each
 //    light is splatted into a light volume cascaded like the G-buffer, at
 //    every level, over the 8 voxels around it by trilinear weights, as an
