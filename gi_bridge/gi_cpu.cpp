@@ -94,24 +94,14 @@ class CpuGi final : public GiEngineBase {
     return {};
   }
 
-  Status run(GiKernel kernel, int first, int count, int level) override {
-    Kernels k{params_, GiPush{first, count, level, 0}, &b_};
-    tbb::parallel_for(tbb::blocked_range<int>(0, count, 64), [&](const tbb::blocked_range<int>& r) {
-      for (int gid = r.begin(); gid < r.end(); ++gid) {
-        switch (kernel) {
-          case GiKernel::kAlpha: k.kernel_alpha(gid); break;
-          case GiKernel::kPrecombine: k.kernel_precombine(gid); break;
-          case GiKernel::kUpdate: k.kernel_update(gid); break;
-          case GiKernel::kQuery: k.kernel_query(gid); break;
-        }
+  Status run_steps(const std::vector<GiStep>& steps) override {
+    for (const GiStep& step : steps) {
+      if (step.commit) {
+        commit(step.first, step.count);
+      } else {
+        run_kernel(step);
       }
-    });
-    return {};
-  }
-
-  Status commit(int first, int count) override {
-    std::copy(b_.light_next.begin() + ptrdiff_t(first) * 18, b_.light_next.begin() + ptrdiff_t(first + count) * 18,
-              b_.light_prev.begin() + ptrdiff_t(first) * 18);
+    }
     return {};
   }
 
@@ -130,6 +120,25 @@ class CpuGi final : public GiEngineBase {
   }
 
  private:
+  void run_kernel(const GiStep& step) {
+    Kernels k{params_, GiPush{step.first, step.count, step.level, 0}, &b_};
+    tbb::parallel_for(tbb::blocked_range<int>(0, step.count, 64), [&](const tbb::blocked_range<int>& r) {
+      for (int gid = r.begin(); gid < r.end(); ++gid) {
+        switch (step.kernel) {
+          case GiKernel::kAlpha: k.kernel_alpha(gid); break;
+          case GiKernel::kPrecombine: k.kernel_precombine(gid); break;
+          case GiKernel::kUpdate: k.kernel_update(gid); break;
+          case GiKernel::kQuery: k.kernel_query(gid); break;
+        }
+      }
+    });
+  }
+
+  void commit(int first, int count) {
+    std::copy(b_.light_next.begin() + ptrdiff_t(first) * 18, b_.light_next.begin() + ptrdiff_t(first + count) * 18,
+              b_.light_prev.begin() + ptrdiff_t(first) * 18);
+  }
+
   GiParams params_{};
   Buffers b_;
 };

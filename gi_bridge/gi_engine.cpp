@@ -308,22 +308,21 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
                                             std::to_string(layout_.k - 1));
   }
   // All reads come from the previous frame's buffers: update every level
-  // first, then commit and precombine.
-  for (int l : levels) {
-    const int c = layout_.level_count[size_t(l)];
-    if (c == 0) continue;
-    if (Status s = run(GiKernel::kUpdate, layout_.level_first[size_t(l)], c, l); !s.ok()) return s;
-    t.surface_voxels += size_t(c);
-  }
+  // first, then commit, then precombine; one batch.
+  std::vector<GiStep> updates, commits, precombines;
   for (int l : levels) {
     const int first = layout_.level_first[size_t(l)], c = layout_.level_count[size_t(l)];
     if (c == 0) continue;
-    if (Status s = commit(first, c); !s.ok()) return s;
-    if (config_.precombined) {
-      const int all = c + layout_.level_shadow[size_t(l)];
-      if (Status s = run(GiKernel::kPrecombine, first * 16, all * 16, l); !s.ok()) return s;
-    }
+    updates.push_back({GiKernel::kUpdate, first, c, l});
+    commits.push_back({GiKernel::kUpdate, first, c, l, true});
+    const int all = c + layout_.level_shadow[size_t(l)];
+    if (config_.precombined) precombines.push_back({GiKernel::kPrecombine, first * 16, all * 16, l});
+    t.surface_voxels += size_t(c);
   }
+  std::vector<GiStep> steps = std::move(updates);
+  steps.insert(steps.end(), commits.begin(), commits.end());
+  steps.insert(steps.end(), precombines.begin(), precombines.end());
+  if (Status s = run_steps(steps); !s.ok()) return s;
   t.levels_updated = int(levels.size());
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return t;

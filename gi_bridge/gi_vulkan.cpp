@@ -1,7 +1,11 @@
 // The Vulkan engine: Vulkan 1.1 core compute only (runs on Mesa's lavapipe),
 // the kernels of shaders/gi.comp compiled by glslc at build time and
-// embedded. Every buffer is host-visible and coherent (on lavapipe all
-// memory is); each primitive is one submit waited on with a fence.
+// embedded. Every buffer is host-visible and coherent, device-local too
+// where the device has such memory (lavapipe: all of it; a discrete GPU:
+// its BAR heap, falling back to host memory when that is full). A lighting
+// update is one command buffer (the levels' updates, the copies of the new
+// light over the old, the precombines, with a barrier between kinds), one
+// submit waited on with a fence.
 #include <cstring>
 #include <vector>
 
@@ -51,14 +55,15 @@ class VulkanGi final : public GiEngineBase {
  protected:
   Status upload(const GiLayout& layout) override;
   Status upload_lights(const GiLayout& layout) override;
-  Status run(GiKernel kernel, int first, int count, int level) override;
-  Status commit(int first, int count) override;
+  Status run_steps(const std::vector<GiStep>& steps) override;
   Status set_queries(const std::vector<glm::vec4>& qin) override;
   Status get_queries(std::vector<glm::vec4>& qout, size_t count) override;
   Status read_light(std::vector<glm::vec4>& light) override;
 
  private:
   Status make_buffer(int binding, VkDeviceSize size, const void* data);
+  uint32_t memory_type(uint32_t allowed, VkMemoryPropertyFlags want) const;
+  void record(const GiStep& step);
   void free_buffer(Buffer& b);
   void write_descriptors();
   Status make_pipelines();
@@ -222,24 +227,24 @@ Status VulkanGi::make_buffer(int binding, VkDeviceSize size, const void* data) {
   size = std::max<VkDeviceSize>(size, 16);
   VkBufferCreateInfo bci{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
   bci.size = size;
-  bci.usage = binding == 0 ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+  bci.usage = (binding == 0 ? VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT : VK_BUFFER_USAGE_STORAGE_BUFFER_BIT) |
+              VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
   bci.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
   if (VkResult r = vkCreateBuffer(device_, &bci, nullptr, &b.buffer); r != VK_SUCCESS) return vk_error("vkCreateBuffer", r);
   VkMemoryRequirements req;
   vkGetBufferMemoryRequirements(device_, b.buffer, &req);
-  VkPhysicalDeviceMemoryProperties mp;
-  vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
-  const VkMemoryPropertyFlags want = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
-  uint32_t type = UINT32_MAX;
-  for (uint32_t i = 0; i < mp.memoryTypeCount && type == UINT32_MAX; ++i) {
-    if ((req.memoryTypeBits & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want) type = i;
-  }
-  if (type == UINT32_MAX) return Status(ErrorCode::kIoError, "vulkan: no host-visible coherent memory type");
+  const VkMemoryPropertyFlags host = VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT;
   VkMemoryAllocateInfo mai{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
   mai.allocationSize = req.size;
-  mai.memoryTypeIndex = type;
-  if (VkResult r = vkAllocateMemory(device_, &mai, nullptr, &b.memory); r != VK_SUCCESS)
-    return vk_error("vkAllocateMemory", r);
+  VkResult alloc = VK_ERROR_OUT_OF_DEVICE_MEMORY;
+  // Device-local first (the kernels read these buffers on every step), then any host-visible memory.
+  for (VkMemoryPropertyFlags want : {host | VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, host}) {
+    mai.memoryTypeIndex = memory_type(req.memoryTypeBits, want);
+    if (mai.memoryTypeIndex == UINT32_MAX) continue;
+    alloc = vkAllocateMemory(device_, &mai, nullptr, &b.memory);
+    if (alloc == VK_SUCCESS) break;
+  }
+  if (alloc != VK_SUCCESS) return vk_error("vkAllocateMemory (host-visible, coherent)", alloc);
   if (VkResult r = vkBindBufferMemory(device_, b.buffer, b.memory, 0); r != VK_SUCCESS)
     return vk_error("vkBindBufferMemory", r);
   if (VkResult r = vkMapMemory(device_, b.memory, 0, size, 0, &b.mapped); r != VK_SUCCESS) return vk_error("vkMapMemory", r);
@@ -247,6 +252,15 @@ Status VulkanGi::make_buffer(int binding, VkDeviceSize size, const void* data) {
   std::memset(b.mapped, 0, size_t(size));
   if (data) std::memcpy(b.mapped, data, size_t(bytes));
   return {};
+}
+
+uint32_t VulkanGi::memory_type(uint32_t allowed, VkMemoryPropertyFlags want) const {
+  VkPhysicalDeviceMemoryProperties mp;
+  vkGetPhysicalDeviceMemoryProperties(physical_, &mp);
+  for (uint32_t i = 0; i < mp.memoryTypeCount; ++i) {
+    if ((allowed & (1u << i)) && (mp.memoryTypes[i].propertyFlags & want) == want) return i;
+  }
+  return UINT32_MAX;
 }
 
 void VulkanGi::write_descriptors() {
@@ -298,27 +312,51 @@ Status VulkanGi::upload_lights(const GiLayout& layout) {
   return {};
 }
 
-Status VulkanGi::run(GiKernel kernel, int first, int count, int level) {
-  if (count <= 0) return {};
-  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-  vkBeginCommandBuffer(cmd_, &begin);
-  vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[int(kernel) - 1]);
-  vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
-  // Items pc.first .. + pc.count per dispatch, as many dispatches as the
-  // group-count limit needs.
+// Records one step: the copy of light_next over light_prev, or the kernel's
+// dispatches (items pc.first .. + pc.count, as many dispatches as the
+// group-count limit needs).
+void VulkanGi::record(const GiStep& step) {
+  if (step.commit) {
+    const VkDeviceSize unit = 18 * sizeof(glm::vec4);
+    const VkBufferCopy region{VkDeviceSize(step.first) * unit, VkDeviceSize(step.first) * unit,
+                              VkDeviceSize(step.count) * unit};
+    vkCmdCopyBuffer(cmd_, buffers_[7].buffer, buffers_[6].buffer, 1, &region);
+    return;
+  }
+  vkCmdBindPipeline(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipelines_[int(step.kernel) - 1]);
   const int per_dispatch = kGroup * kMaxGroups;
-  for (int done = 0; done < count; done += per_dispatch) {
-    GiPush push{first + done, std::min(per_dispatch, count - done), level, 0};
+  for (int done = 0; done < step.count; done += per_dispatch) {
+    GiPush push{step.first + done, std::min(per_dispatch, step.count - done), step.level, 0};
     vkCmdPushConstants(cmd_, pipeline_layout_, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(push), &push);
     vkCmdDispatch(cmd_, uint32_t((push.count + kGroup - 1) / kGroup), 1, 1);
   }
-  // The host reads (memcpy) what the shaders wrote: make it visible.
+}
+
+Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
+  VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+  begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+  vkBeginCommandBuffer(cmd_, &begin);
+  vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
+  const VkPipelineStageFlags work = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+  for (size_t i = 0; i < steps.size(); ++i) {
+    if (steps[i].count <= 0) continue;
+    // Steps of one kind touch disjoint items; a step of another kind waits
+    // for everything before it (reads after writes, and the copies
+    // overwrite light the updates read).
+    if (i > 0 && (steps[i].commit != steps[i - 1].commit || steps[i].kernel != steps[i - 1].kernel)) {
+      VkMemoryBarrier between{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+      between.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
+      between.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
+                              VK_ACCESS_TRANSFER_WRITE_BIT;
+      vkCmdPipelineBarrier(cmd_, work, work, 0, 1, &between, 0, nullptr, 0, nullptr);
+    }
+    record(steps[i]);
+  }
+  // The host reads (memcpy) what the steps wrote: make it visible.
   VkMemoryBarrier to_host{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+  to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-  vkCmdPipelineBarrier(cmd_, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0,
-                       nullptr, 0, nullptr);
+  vkCmdPipelineBarrier(cmd_, work, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
   vkEndCommandBuffer(cmd_);
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
@@ -328,12 +366,6 @@ Status VulkanGi::run(GiKernel kernel, int first, int count, int level) {
     return vk_error("vkWaitForFences", r);
   vkResetFences(device_, 1, &fence_);
   vkResetCommandBuffer(cmd_, 0);
-  return {};
-}
-
-Status VulkanGi::commit(int first, int count) {
-  const size_t off = size_t(first) * 18 * sizeof(glm::vec4), n = size_t(count) * 18 * sizeof(glm::vec4);
-  std::memcpy(static_cast<char*>(buffers_[6].mapped) + off, static_cast<const char*>(buffers_[7].mapped) + off, n);
   return {};
 }
 

@@ -34,6 +34,15 @@ struct GiPush {
 
 enum class GiKernel { kAlpha = 1, kPrecombine = 2, kUpdate = 3, kQuery = 4 };
 
+// One step of the work a backend runs in a batch: a kernel over `count`
+// items from `first` (pc.level = level), or, with commit, the copy of
+// light_next to light_prev for surface voxels [first, first + count).
+struct GiStep {
+  GiKernel kernel = GiKernel::kUpdate;
+  int first = 0, count = 0, level = 0;
+  bool commit = false;
+};
+
 struct GiLayout {
   GiParams params{};
   int n = 0, k = 0;
@@ -72,10 +81,10 @@ class GiEngineBase : public GiEngine {
   virtual Status upload(const GiLayout& layout) = 0;
   // Replaces the uniform block and the light volume (set_lights).
   virtual Status upload_lights(const GiLayout& layout) = 0;
-  // Runs kernel over `count` items from `first` with pc.level = level.
-  virtual Status run(GiKernel kernel, int first, int count, int level) = 0;
-  // Copies light_next to light_prev for surface voxels [first, first + count).
-  virtual Status commit(int first, int count) = 0;
+  // Runs the steps in order, each seeing what the ones before wrote (the
+  // Vulkan engine records them in one command buffer: one submit).
+  virtual Status run_steps(const std::vector<GiStep>& steps) = 0;
+  Status run(GiKernel kernel, int first, int count, int level) { return run_steps({{kernel, first, count, level}}); }
   virtual Status set_queries(const std::vector<glm::vec4>& qin) = 0;
   virtual Status get_queries(std::vector<glm::vec4>& qout, size_t count) = 0;
   virtual Status read_light(std::vector<glm::vec4>& light) = 0;
