@@ -49,7 +49,7 @@
 //    only. An unoccluded light is exact; shadows are as soft as the
 //    cascades' voxels at the distance. (Blending the 16 cones'
 //    transmittances by the light's direction gave a mean error of 42% on
-//    the Cornell box's light instead of 30%, but 10% instead of 16% in the
+//    the Cornell box's light instead of 31%, but 10% instead of 15% in the
 //    landscape's cave: see docs/benchmarks.md.)
 //  - injected (the talk's method; at most kGiMaxInjectedPointLights): each
 //    light is splatted into a light volume cascaded like the G-buffer, at
