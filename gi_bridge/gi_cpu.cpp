@@ -96,7 +96,7 @@ class CpuGi final : public GiEngineBase {
 
   Status run_steps(const std::vector<GiStep>& steps) override {
     for (const GiStep& step : steps) {
-      if (step.commit) {
+      if (step.kernel == GiKernel::kCommit) {
         commit(step.first, step.count);
       } else {
         run_kernel(step);
@@ -129,6 +129,7 @@ class CpuGi final : public GiEngineBase {
           case GiKernel::kPrecombine: k.kernel_precombine(gid); break;
           case GiKernel::kUpdate: k.kernel_update(gid); break;
           case GiKernel::kQuery: k.kernel_query(gid); break;
+          case GiKernel::kCommit: break;  // run_steps copies
         }
       }
     });

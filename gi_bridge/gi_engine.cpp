@@ -129,7 +129,7 @@ void inject_point_lights(const std::vector<PointLight>& lights, GiLayout& out) {
         const glm::ivec3 o(k & 1, (k >> 1) & 1, (k >> 2) & 1);
         const glm::ivec3 c = c0 + o;
         if (glm::any(glm::lessThan(c, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(c, glm::ivec3(n)))) continue;
-        voxel[k] = size_t(l) * size_t(n) * n * n + (size_t(c.z) * n + size_t(c.y)) * n + size_t(c.x);
+        voxel[k] = out.voxel(l, c);
         double occ = 0.0;
         for (int face = 0; face < 6; ++face) occ += out.occ[voxel[k] * 6 + size_t(face)] / 6.0;
         const double tri = (o.x ? f.x : 1.0 - f.x) * (o.y ? f.y : 1.0 - f.y) * (o.z ? f.z : 1.0 - f.z);
@@ -155,7 +155,6 @@ void fill_light_params(const GiLights& lights, const GiConfig& config, GiLayout&
     p.light_pos[i] = i < exact ? glm::vec4(glm::vec3(lights.points[i].position - out.origin), 1.0f) : glm::vec4(0.0f);
     p.light_int[i] = i < exact ? glm::vec4(lights.points[i].intensity, 0.0f) : glm::vec4(0.0f);
   }
-  p.fparams.w = lights.sky.sharpness;
   p.iparams.w = int(exact);
   out.light_volume.assign(config.light_volume ? out.voxels() : 0, glm::vec4(0.0f));
   if (config.light_volume) inject_point_lights(lights.points, out);
@@ -187,12 +186,10 @@ bool propagated_face(const FaceSample& f) { return f.flags == kFacePropagated &&
 // is (a closed emissive box gave irradiance 1.58 instead of pi).
 void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
   const int n = out.n;
-  const size_t level_base = size_t(l) * size_t(n) * n * n;
-  auto voxel_of = [&](const glm::ivec3& c) { return level_base + (size_t(c.z) * n + size_t(c.y)) * n + size_t(c.x); };
   out.level_first[size_t(l)] = int(out.surf_pos.size());
   std::vector<glm::ivec3> shadows;
   auto add_entry = [&](const glm::ivec3& c, const FaceSample* f, bool updated) {
-    out.vmap[voxel_of(c)] = int32_t(out.surf_pos.size());
+    out.vmap[out.voxel(l, c)] = int32_t(out.surf_pos.size());
     out.surf_pos.emplace_back(c, l);
     for (int i = 0; i < kFaces; ++i) {
       out.attr.emplace_back(glm::vec3(f[i].albedo), updated && own_face(f[i]) ? f[i].albedo.a : 0.0f);
@@ -204,7 +201,7 @@ void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
     for (int y = 0; y < n; ++y) {
       for (int x = 0; x < n; ++x) {
         const glm::ivec3 c(x, y, z);
-        const size_t voxel = voxel_of(c);
+        const size_t voxel = out.voxel(l, c);
         out.vmap[voxel] = -1;
         if (!valid) continue;
         FaceSample f[kFaces];
@@ -243,7 +240,7 @@ void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
         glm::ivec3 nb = c;
         nb[face_axis(i)] += face_positive(i) ? 1 : -1;
         const int32_t t = glm::all(glm::greaterThanEqual(nb, glm::ivec3(0))) && glm::all(glm::lessThan(nb, glm::ivec3(n)))
-                              ? out.vmap[voxel_of(nb)]
+                              ? out.vmap[out.voxel(l, nb)]
                               : -1;
         if (t >= 0 && s_is_updated(out, l, t)) src = t * 6 + i;
       }
@@ -314,7 +311,7 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
     const int first = layout_.level_first[size_t(l)], c = layout_.level_count[size_t(l)];
     if (c == 0) continue;
     updates.push_back({GiKernel::kUpdate, first, c, l});
-    commits.push_back({GiKernel::kUpdate, first, c, l, true});
+    commits.push_back({GiKernel::kCommit, first, c, l});
     const int all = c + layout_.level_shadow[size_t(l)];
     if (config_.precombined) precombines.push_back({GiKernel::kPrecombine, first * 16, all * 16, l});
     t.surface_voxels += size_t(c);

@@ -316,7 +316,7 @@ Status VulkanGi::upload_lights(const GiLayout& layout) {
 // dispatches (items pc.first .. + pc.count, as many dispatches as the
 // group-count limit needs).
 void VulkanGi::record(const GiStep& step) {
-  if (step.commit) {
+  if (step.kernel == GiKernel::kCommit) {
     const VkDeviceSize unit = 18 * sizeof(glm::vec4);
     const VkBufferCopy region{VkDeviceSize(step.first) * unit, VkDeviceSize(step.first) * unit,
                               VkDeviceSize(step.count) * unit};
@@ -343,7 +343,7 @@ Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
     // Steps of one kind touch disjoint items; a step of another kind waits
     // for everything before it (reads after writes, and the copies
     // overwrite light the updates read).
-    if (i > 0 && (steps[i].commit != steps[i - 1].commit || steps[i].kernel != steps[i - 1].kernel)) {
+    if (i > 0 && steps[i].kernel != steps[i - 1].kernel) {
       VkMemoryBarrier between{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
       between.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
       between.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |

@@ -53,15 +53,7 @@ Result<GiLights> parse_lights(const GiArgs& a) {
   l.sky = SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f));
   for (const std::string& text : a.lights) {
     std::vector<double> v;
-    bool numbers = true;
-    std::istringstream in(text);
-    std::string item;
-    while (std::getline(in, item, ',')) {
-      char* end = nullptr;
-      v.push_back(std::strtod(item.c_str(), &end));
-      numbers = numbers && !item.empty() && *end == '\0' && std::isfinite(v.back());
-    }
-    if (!numbers || (v.size() != 4 && v.size() != 6))
+    if (!parse_numbers(text, &v) || (v.size() != 4 && v.size() != 6))
       return Status(ErrorCode::kInvalidArgument, "--light " + text + ": want x,y,z,I or x,y,z,r,g,b (finite numbers)");
     const glm::vec3 intensity = v.size() == 4 ? glm::vec3(float(v[3])) : glm::vec3(float(v[3]), float(v[4]), float(v[5]));
     l.points.push_back({glm::dvec3(v[0], v[1], v[2]), intensity});

@@ -69,15 +69,25 @@ Result<nlohmann::json> read_json_file(const std::string& path) {
   }
 }
 
-bool parse_vec3(const std::string& text, glm::dvec3* out) {
+bool parse_numbers(const std::string& text, std::vector<double>* out) {
   std::istringstream in(text);
-  char c1 = 0, c2 = 0;
-  glm::dvec3 v;
-  if (!(in >> v.x >> c1 >> v.y >> c2 >> v.z) || c1 != ',' || c2 != ',') return false;
-  std::string rest;
-  if (in >> rest) return false;
-  if (!detail::is_finite(v)) return false;
-  *out = v;
+  std::vector<double> v;
+  for (char sep = ','; sep == ',';) {
+    double x = 0.0;
+    if (!(in >> x) || !std::isfinite(x)) return false;
+    v.push_back(x);
+    sep = 0;
+    in >> sep;  // ',' or the end
+    if (sep != ',' && sep != 0) return false;
+  }
+  *out = std::move(v);
+  return true;
+}
+
+bool parse_vec3(const std::string& text, glm::dvec3* out) {
+  std::vector<double> v;
+  if (!parse_numbers(text, &v) || v.size() != 3) return false;
+  *out = glm::dvec3(v[0], v[1], v[2]);
   return true;
 }
 

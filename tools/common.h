@@ -57,6 +57,8 @@ bool has_ldc_extension(const std::string& path);
 // [x, y, z] for JSON output.
 nlohmann::json vec_json(const glm::dvec3& v);
 
+// "1,2.5,3" -> finite numbers; false when malformed.
+bool parse_numbers(const std::string& text, std::vector<double>* out);
 // "1,2,3" -> vector; false when malformed.
 bool parse_vec3(const std::string& text, glm::dvec3* out);
 

@@ -18,7 +18,7 @@ struct GiParams {
   glm::vec4 sky[16];
   glm::vec4 light_pos[kGiMaxPointLights];
   glm::vec4 light_int[kGiMaxPointLights];
-  glm::vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset, w RBF sharpness
+  glm::vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset, w unused
   glm::ivec4 iparams;  // x N, y K, z flags, w exact point lights
   glm::vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
   glm::ivec4 lo[kGiMaxLevels];
@@ -32,15 +32,15 @@ struct GiPush {
   int pad = 0;
 };
 
-enum class GiKernel { kAlpha = 1, kPrecombine = 2, kUpdate = 3, kQuery = 4 };
-
-// One step of the work a backend runs in a batch: a kernel over `count`
-// items from `first` (pc.level = level), or, with commit, the copy of
+// The shaders' kernels (GI_KERNEL 1..4), and kCommit: the copy of
 // light_next to light_prev for surface voxels [first, first + count).
+enum class GiKernel { kAlpha = 1, kPrecombine = 2, kUpdate = 3, kQuery = 4, kCommit = 5 };
+
+// One step of the work a backend runs in a batch: `kernel` over `count`
+// items from `first`, with pc.level = level.
 struct GiStep {
   GiKernel kernel = GiKernel::kUpdate;
   int first = 0, count = 0, level = 0;
-  bool commit = false;
 };
 
 struct GiLayout {
@@ -58,6 +58,10 @@ struct GiLayout {
   // light on propagated faces (precombined, never updated).
   std::vector<int> level_first, level_count, level_shadow;
   size_t voxels() const { return size_t(k) * size_t(n) * size_t(n) * size_t(n); }
+  // Index of voxel c (local coordinates) of level l: the kernels' voxel_index.
+  size_t voxel(int l, const glm::ivec3& c) const {
+    return ((size_t(l) * size_t(n) + size_t(c.z)) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x);
+  }
   size_t surfaces() const { return surf_pos.size(); }
 };
 

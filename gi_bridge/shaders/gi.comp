@@ -14,7 +14,7 @@ layout(std140, binding = 0) uniform Params {
   vec4 sky[16];
   vec4 light_pos[8];
   vec4 light_int[8];
-  vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset (voxels), w RBF sharpness
+  vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset (voxels), w unused
   ivec4 iparams;  // x N, y K, z flags, w exact point lights
   vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
   ivec4 lo[16];

@@ -23,7 +23,6 @@
 // Cone half-angle of the 16 cones: solid angle 4 pi / 16 = pi / 4, so
 // cos = 7/8 and tan = sqrt(15) / 7.
 GI_CONST float kTanHalf = 0.5532833352f;
-GI_CONST float kConeSolidAngle = 0.7853981634f;
 GI_CONST float kPi = 3.1415926536f;
 GI_CONST int kFlagPrecombined = 1;
 GI_CONST int kFlagNearFar = 2;
@@ -188,6 +187,16 @@ vec3 sample_light_volume(int l, vec3 u) {
   return r;
 }
 
+// The level a march samples at p where the cone is diam wide: the
+// coarsest not wider than the cone (at least l0), or a coarser one where p
+// leaves that level's box; gi_k() past the coarsest. u: p's coordinates in it.
+int march_level(vec3 p, float diam, int l0, OUT(vec3) u) {
+  int l = l0;
+  while (l + 1 < gi_k() && level_size(l + 1) <= diam) ++l;
+  while (l < gi_k() && !level_coords(l, p, u)) ++l;
+  return l;
+}
+
 // What one cone gathers: light of the three buffers and of the direct
 // sources, each already multiplied by the transmittance in front of it.
 struct ConeResult {
@@ -199,8 +208,9 @@ struct ConeResult {
 };
 
 // Marches the cone along dir from apex (relative to the lattice origin)
-// starting at distance t0 at level l0 or coarser. `lit`: the point being lit. Injected light at p reaches it as
-// 1 / |p - lit|^2, not as the cone's 1 / t^2 from its apex: a query's apex
+// starting at distance t0 at level l0 or coarser. `lit`: the point being
+// lit. Injected light at p reaches it as 1 / |p - lit|^2, not as the
+// cone's 1 / t^2 from its apex: a query's apex
 // sits a voxel above the surface, and without the correction a light 1.75
 // voxels above a plane gave 1.7 times its irradiance.
 ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float t1) {
@@ -216,12 +226,9 @@ ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float 
   bool escaped = false;
   for (int step = 0; step < kMaxSteps; ++step) {
     if (t >= t1) break;
-    float diam = max(2.0f * kTanHalf * t, base);
-    int l = l0;
-    while (l + 1 < gi_k() && level_size(l + 1) <= diam) ++l;
     vec3 p = apex + t * d;
     vec3 u = vec3(0.0f);
-    while (l < gi_k() && !level_coords(l, p, u)) ++l;
+    int l = march_level(p, max(2.0f * kTanHalf * t, base), l0, u);
     if (l == gi_k()) {
       escaped = true;
       break;
@@ -280,11 +287,8 @@ float shadow_transmittance(vec3 apex, vec3 target, int l0, float t0) {
   float t = t0;
   float base = level_size(l0);
   for (int step = 0; step < kMaxSteps && t < dist; ++step) {
-    float diam = max(2.0f * kShadowTan * t, base);
-    int l = l0;
-    while (l + 1 < gi_k() && level_size(l + 1) <= diam) ++l;
     vec3 u = vec3(0.0f);
-    while (l < gi_k() && !level_coords(l, apex + t * d, u)) ++l;
+    int l = march_level(apex + t * d, max(2.0f * kShadowTan * t, base), l0, u);
     if (l == gi_k()) break;
     float a = min(sample_alpha(l, u, d, apex), 1.0f);
     T *= sqrt(1.0f - a);  // half a voxel's opacity, as in trace_cone_lit
@@ -410,8 +414,7 @@ void kernel_update(int gid) {
       float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
       if (c <= 0.0f) continue;
       if (split) {
-        float t1 = ts - 0.5f * vs * c;
-        ConeResult nr = trace_cone_range(apex_f, i, l, 0.5f * vs, t1);
+        ConeResult nr = trace_cone_range(apex_f, i, l, 0.5f * vs, ts - 0.5f * vs * c);
         es += c * (nr.src + nr.transmittance * src[i]);
         ed += c * (nr.d + nr.transmittance * gd[i]);
         eb += c * (nr.b1 + nr.transmittance * gb1[i]);
