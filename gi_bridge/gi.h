@@ -165,7 +165,11 @@ Status check_gi_lights(const GiLights& lights, const GiConfig& config);
 struct GiTimings {
   int levels_updated = 0;
   size_t surface_voxels = 0;
-  double seconds = 0.0;  // wall time (GPU: submit to fence)
+  double seconds = 0.0;  // wall time (GPU: recording, submit, fence)
+  // Time the device spent on the work itself: GPU timestamps around the
+  // update's command buffer (Vulkan), the kernels' wall time (CPU engine);
+  // < 0 where the device's queue has no timestamps.
+  double device_seconds = -1.0;
 };
 
 // Per-face radiance read back: for each surface voxel (level, global voxel

@@ -1,5 +1,6 @@
 // The CPU reference: the same kernels as the Vulkan shaders
 // (shaders/gi_common.glsl, included here), run over the items in parallel.
+#include <chrono>
 #include <cmath>
 
 #include <tbb/parallel_for.h>
@@ -95,6 +96,7 @@ class CpuGi final : public GiEngineBase {
   }
 
   Status run_steps(const std::vector<GiStep>& steps) override {
+    const auto t0 = std::chrono::steady_clock::now();
     for (const GiStep& step : steps) {
       if (step.kernel == GiKernel::kCommit) {
         commit(step.first, step.count);
@@ -102,6 +104,7 @@ class CpuGi final : public GiEngineBase {
         run_kernel(step);
       }
     }
+    last_device_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return {};
   }
 

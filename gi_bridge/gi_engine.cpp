@@ -322,6 +322,7 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
   if (Status s = run_steps(steps); !s.ok()) return s;
   t.levels_updated = int(levels.size());
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  t.device_seconds = steps.empty() ? 0.0 : last_device_seconds_;
   return t;
 }
 
@@ -337,6 +338,8 @@ Result<GiTimings> GiEngineBase::update_all(int passes) {
     sum.levels_updated += t.value().levels_updated;
     sum.surface_voxels += t.value().surface_voxels;
     sum.seconds += t.value().seconds;
+    const double dev = t.value().device_seconds;
+    sum.device_seconds = p == 0 ? dev : (dev < 0 || sum.device_seconds < 0 ? -1.0 : sum.device_seconds + dev);
   }
   return sum;
 }

@@ -5,7 +5,8 @@
 // its BAR heap, falling back to host memory when that is full). A lighting
 // update is one command buffer (the levels' updates, the copies of the new
 // light over the old, the precombines, with a barrier between kinds), one
-// submit waited on with a fence.
+// submit waited on with a fence; two GPU timestamps around its work give
+// GiTimings::device_seconds.
 #include <cstring>
 #include <vector>
 
@@ -67,6 +68,8 @@ class VulkanGi final : public GiEngineBase {
   void free_buffer(Buffer& b);
   void write_descriptors();
   Status make_pipelines();
+  Status make_timestamps();
+  double device_seconds() const;
   void destroy();
 
   VkInstance instance_ = VK_NULL_HANDLE;
@@ -82,6 +85,11 @@ class VulkanGi final : public GiEngineBase {
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
+  // Two timestamps around each submit's work; none where the queue family
+  // has no timestamps (timestampValidBits 0).
+  VkQueryPool timestamps_ = VK_NULL_HANDLE;
+  uint64_t timestamp_mask_ = 0;
+  double timestamp_period_ns_ = 1.0;
   Buffer buffers_[kBindings];
 };
 
@@ -151,7 +159,38 @@ Status VulkanGi::init(std::string* device_name) {
     return vk_error("vkAllocateCommandBuffers", r);
   VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   if (VkResult r = vkCreateFence(device_, &fci, nullptr, &fence_); r != VK_SUCCESS) return vk_error("vkCreateFence", r);
+  if (Status s = make_timestamps(); !s.ok()) return s;
   return make_pipelines();
+}
+
+Status VulkanGi::make_timestamps() {
+  uint32_t nq = 0;
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, nullptr);
+  std::vector<VkQueueFamilyProperties> qs(nq);
+  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, qs.data());
+  const uint32_t bits = qs[queue_family_].timestampValidBits;
+  if (bits == 0) return {};  // GiTimings::device_seconds stays -1
+  VkPhysicalDeviceProperties props;
+  vkGetPhysicalDeviceProperties(physical_, &props);
+  timestamp_mask_ = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
+  timestamp_period_ns_ = double(props.limits.timestampPeriod);
+  VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+  qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
+  qpi.queryCount = 2;
+  if (VkResult r = vkCreateQueryPool(device_, &qpi, nullptr, &timestamps_); r != VK_SUCCESS)
+    return vk_error("vkCreateQueryPool", r);
+  return {};
+}
+
+// Seconds between the two timestamps of the last submit; -1 without them.
+double VulkanGi::device_seconds() const {
+  if (timestamps_ == VK_NULL_HANDLE) return -1.0;
+  uint64_t t[2] = {0, 0};
+  if (vkGetQueryPoolResults(device_, timestamps_, 0, 2, sizeof(t), t, sizeof(uint64_t),
+                            VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT) != VK_SUCCESS)
+    return -1.0;
+  const uint64_t ticks = ((t[1] & timestamp_mask_) - (t[0] & timestamp_mask_)) & timestamp_mask_;
+  return double(ticks) * timestamp_period_ns_ * 1e-9;
 }
 
 Status VulkanGi::make_pipelines() {
@@ -336,6 +375,10 @@ Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
   VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   vkBeginCommandBuffer(cmd_, &begin);
+  if (timestamps_ != VK_NULL_HANDLE) {
+    vkCmdResetQueryPool(cmd_, timestamps_, 0, 2);
+    vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, 0);
+  }
   vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
   const VkPipelineStageFlags work = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
   for (size_t i = 0; i < steps.size(); ++i) {
@@ -357,6 +400,7 @@ Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
   to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
   vkCmdPipelineBarrier(cmd_, work, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
+  if (timestamps_ != VK_NULL_HANDLE) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, 1);
   vkEndCommandBuffer(cmd_);
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
@@ -366,6 +410,7 @@ Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
     return vk_error("vkWaitForFences", r);
   vkResetFences(device_, 1, &fence_);
   vkResetCommandBuffer(cmd_, 0);
+  last_device_seconds_ = device_seconds();
   return {};
 }
 
@@ -404,6 +449,7 @@ void VulkanGi::destroy() {
     if (pipeline_layout_) vkDestroyPipelineLayout(device_, pipeline_layout_, nullptr);
     if (set_layout_) vkDestroyDescriptorSetLayout(device_, set_layout_, nullptr);
     if (fence_) vkDestroyFence(device_, fence_, nullptr);
+    if (timestamps_) vkDestroyQueryPool(device_, timestamps_, nullptr);
     if (command_pool_) vkDestroyCommandPool(device_, command_pool_, nullptr);
     vkDestroyDevice(device_, nullptr);
   }

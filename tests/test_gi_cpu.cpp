@@ -440,6 +440,21 @@ TEST(GiCpu, NearFarSplitConesKeepWallsClosedAndTheSkyOpen) {
   }
 }
 
+// The CPU engine's device time is its kernels' wall time: positive, within
+// the update's wall time, summed over update_all's passes.
+TEST(GiCpu, DeviceTimeIsTheKernelsTime) {
+  const World world = test::build_boxes(test::closed_room(2));
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  ASSERT_TRUE(gi->load(cas, GiLights{}).ok());
+  for (int passes : {1, 3}) {
+    Result<GiTimings> t = gi->update_all(passes);
+    ASSERT_TRUE(t.ok());
+    EXPECT_GT(t.value().device_seconds, 0.0) << passes << " passes";
+    EXPECT_LE(t.value().device_seconds, t.value().seconds) << passes << " passes";
+  }
+}
+
 TEST(GiCpu, QueriesBeforeLoadAreRefused) {
   auto gi = make_cpu_gi();
   std::vector<glm::vec3> e(1);

@@ -230,7 +230,7 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
                      {"surface_voxels", upd.value().surface_voxels / size_t(a.passes)},
                      {"passes", a.passes},
                      {"point_lights", {{"count", lights.points.size()}, {"mode", a.light_volume ? "injected volume" : "exact"}}},
-                     {"seconds", {{"voxelize", vox_s}, {"lighting", upd.value().seconds}, {"image", img_s}}},
+                     {"seconds", {{"voxelize", vox_s}, {"lighting", upd.value().seconds}, {"lighting_device", upd.value().device_seconds}, {"image", img_s}}},
                      {"image", {{"width", wdt}, {"height", hgt}, {"bounces", a.bounces}}},
                      {"output", a.output}};
     if (a.reference) {
@@ -242,8 +242,11 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
   }
   std::printf("gi: %s, %d levels of %d^3 voxels of %.3g m, %zu surface voxels; voxelize %.3f s\n", device.c_str(),
               a.levels, a.resolution, cc.voxel_size, upd.value().surface_voxels / size_t(a.passes), vox_s);
-  std::printf("gi: %d lighting passes %.3f s (%.3f s each), image %d x %d (%d bounces) %.3f s\n", a.passes,
-              upd.value().seconds, upd.value().seconds / a.passes, wdt, hgt, a.bounces, img_s);
+  char device_time[64] = "";  // GPU timestamps (or the CPU engine's kernels); none without timestamps
+  if (upd.value().device_seconds >= 0)
+    std::snprintf(device_time, sizeof(device_time), " (device %.3f s each)", upd.value().device_seconds / a.passes);
+  std::printf("gi: %d lighting passes %.3f s (%.3f s each)%s, image %d x %d (%d bounces) %.3f s\n", a.passes,
+              upd.value().seconds, upd.value().seconds / a.passes, device_time, wdt, hgt, a.bounces, img_s);
   if (a.reference) std::printf("gi: path-traced reference, %d paths per pixel, %.3f s (right half)\n", a.samples, ref_s);
   std::printf("wrote %s\n", a.output.c_str());
   return 0;

@@ -86,7 +86,8 @@ class GiEngineBase : public GiEngine {
   // Replaces the uniform block and the light volume (set_lights).
   virtual Status upload_lights(const GiLayout& layout) = 0;
   // Runs the steps in order, each seeing what the ones before wrote (the
-  // Vulkan engine records them in one command buffer: one submit).
+  // Vulkan engine records them in one command buffer: one submit), and
+  // sets last_device_seconds_ (GiTimings::device_seconds).
   virtual Status run_steps(const std::vector<GiStep>& steps) = 0;
   Status run(GiKernel kernel, int first, int count, int level) { return run_steps({{kernel, first, count, level}}); }
   virtual Status set_queries(const std::vector<glm::vec4>& qin) = 0;
@@ -99,6 +100,7 @@ class GiEngineBase : public GiEngine {
   GiLayout layout_;
   bool loaded_ = false;
   uint64_t frame_ = 0;
+  double last_device_seconds_ = -1.0;
 };
 
 }  // namespace ldc::detail

@@ -161,6 +161,26 @@ TEST(GiVulkan, SkyOnlyOpenPlaneGetsTheAnalyticIrradiance) {
   EXPECT_NEAR(e[0].g, 3.14159f, 0.1f * 3.14159f) << "tolerance 10%";
 }
 
+// GPU timestamps around an update's work: positive and within the wall
+// time from recording to fence (a device whose queue has no timestamps
+// reports -1, and says so here); update_all sums its passes.
+TEST(GiVulkan, DeviceTimeIsMeasuredWithinTheWallTime) {
+  auto gpu = vulkan_or_skip();
+  if (!gpu) GTEST_SKIP() << "no Vulkan device";
+  const Scene scene = lit_room();
+  ASSERT_TRUE(gpu->load(scene.cascades, scene.lights).ok());
+  Result<GiTimings> one = gpu->update_all(1);
+  ASSERT_TRUE(one.ok());
+  if (one.value().device_seconds < 0) GTEST_SKIP() << "the device's queue has no timestamps";
+  EXPECT_GT(one.value().device_seconds, 0.0);
+  EXPECT_LE(one.value().device_seconds, 1.05 * one.value().seconds + 1e-4);
+  Result<GiTimings> two = gpu->update_all(2);
+  ASSERT_TRUE(two.ok());
+  EXPECT_GT(two.value().device_seconds, 0.0);
+  EXPECT_LE(two.value().device_seconds, 1.05 * two.value().seconds + 1e-4);
+  EXPECT_EQ(two.value().levels_updated, 2 * one.value().levels_updated);
+}
+
 // frame() follows the cascades' schedule: frame f updates exactly the level
 // Cascades::scheduled_level(f, K) (checked by its surface-voxel count against
 // the CPU engine updating that level by hand); unstaggered, every level.
