@@ -10,7 +10,7 @@
 // the cone-traced irradiance against the path-traced reference (Embree on
 // the contoured mesh) at the same points, for 1, 2 and 3 bounces.
 // Usage: bench_gi [points (200)] [paths per point (512)] [sources: only the
-// error split by light source]
+// error split by light source | timing: only medians of full updates]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -322,12 +322,50 @@ void by_source(const Scene& s, int points, int paths) {
   }
 }
 
+// Timing only (`bench_gi 0 0 timing`): per scene and engine (default
+// config), the median and the minimum of 9 full updates after 3 passes, wall
+// and device time (single runs are noisy: lavapipe shares the cores).
+void timing(const Scene& s) {
+  Result<Cascades> cas = bench_cascades(s, s.materials);
+  if (!cas.ok()) return;
+  for (int cpu = 0; cpu < 2; ++cpu) {
+    std::string device = "cpu";
+    std::unique_ptr<GiEngine> engine;
+    if (cpu) {
+      engine = make_cpu_gi();
+    } else {
+      Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi({}, &device);
+      if (!gi.ok()) continue;
+      engine = std::move(gi).value();
+    }
+    if (!engine->load(cas.value(), s.lights).ok() || !engine->update_all(3).ok()) return;
+    std::vector<double> wall, dev;
+    for (int r = 0; r < 9; ++r) {
+      Result<GiTimings> t = engine->update_all(1);
+      if (!t.ok()) return;
+      wall.push_back(t.value().seconds);
+      dev.push_back(t.value().device_seconds);
+    }
+    std::sort(wall.begin(), wall.end());
+    std::sort(dev.begin(), dev.end());
+    std::printf("| %s | %s | %.4f | %.4f | %.4f | %.4f |\n", s.name.c_str(), device.c_str(), wall[4], wall[0], dev[4],
+                dev[0]);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const int points = argc > 1 ? std::atoi(argv[1]) : 200;
   const int paths = argc > 2 ? std::atoi(argv[2]) : 512;
   std::printf("# bench_gi: cone-traced GI (Vulkan engine rows name their device; llvmpipe = Mesa's lavapipe on the CPU) vs path-traced reference\n");
+  if (argc > 3 && std::string(argv[3]) == "timing") {
+    std::printf("| scene | engine | full update s (median of 9) | min | device s (median) | min |\n|---|---|---|---|---|---|\n");
+    timing(cornell());
+    timing(landscape());
+    timing(shared_mesh());
+    return 0;
+  }
   if (argc > 3 && std::string(argv[3]) == "sources") {
     by_source(cornell(), points, paths);
     by_source(landscape(), points, paths);

@@ -29,7 +29,7 @@ struct Buffers {
   std::vector<float> occ, alpha;
   std::vector<int32_t> vmap, fsrc;
   std::vector<ivec4> surf_pos;
-  std::vector<vec4> attr, light_prev, light_next, pre, qin, qout, plight;
+  std::vector<vec4> attr, light_prev, light_next, pre, qin, qout, plight, cones;
 };
 
 #define GI_CONST static constexpr
@@ -59,6 +59,8 @@ struct Kernels {
   vec4 qin_load(int i) const { return b->qin[size_t(i)]; }
   void qout_store(int i, vec4 v) const { b->qout[size_t(i)] = v; }
   vec4 plight_load(int i) const { return b->plight[size_t(i)]; }
+  vec4 cone_load(int i) const { return b->cones[size_t(i)]; }
+  void cone_store(int i, vec4 v) const { b->cones[size_t(i)] = v; }
 
 #include "gi_bridge/shaders/gi_common.glsl"
 };
@@ -86,6 +88,7 @@ class CpuGi final : public GiEngineBase {
     b_.light_prev.assign(layout.surfaces() * 18, vec4(0.0f));
     b_.light_next = b_.light_prev;
     b_.pre.assign(layout.surfaces() * 48, vec4(0.0f));
+    b_.cones.assign(layout.surfaces() * 48, vec4(0.0f));
     return upload_lights(layout);
   }
 
@@ -132,6 +135,7 @@ class CpuGi final : public GiEngineBase {
           case GiKernel::kPrecombine: k.kernel_precombine(gid); break;
           case GiKernel::kUpdate: k.kernel_update(gid); break;
           case GiKernel::kQuery: k.kernel_query(gid); break;
+          case GiKernel::kCones: k.kernel_cones(gid); break;
           case GiKernel::kCommit: break;  // run_steps copies
         }
       }

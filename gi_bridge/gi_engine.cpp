@@ -167,7 +167,10 @@ void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfi
   p.iparams = glm::ivec4(out.n, out.k,
                          (config.precombined ? 1 : 0) | (config.near_far ? 2 : 0) | (config.light_volume ? 4 : 0), 0);
   p.fparams2 = glm::vec4(config.near_far_split, 0.0f, 0.0f, 0.0f);
-  for (int l = 0; l < out.k; ++l) p.lo[l] = glm::ivec4(cascades.level_box(l).lo, 0);
+  for (int l = 0; l < out.k; ++l) {
+    p.lo[l] = glm::ivec4(cascades.level_box(l).lo, 0);
+    p.surf[l] = glm::ivec4(out.level_first[size_t(l)], out.level_count[size_t(l)], 0, 0);
+  }
   fill_light_params(lights, config, out);
 }
 
@@ -304,19 +307,21 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
     if (l < 0 || l >= layout_.k) return bad("gi: level " + std::to_string(l) + " is not in 0 .. " +
                                             std::to_string(layout_.k - 1));
   }
-  // All reads come from the previous frame's buffers: update every level
-  // first, then commit, then precombine; one batch.
-  std::vector<GiStep> updates, commits, precombines;
+  // All reads come from the previous frame's buffers: trace every level's
+  // cones, then update, then commit, then precombine; one batch.
+  std::vector<GiStep> cones, updates, commits, precombines;
   for (int l : levels) {
     const int first = layout_.level_first[size_t(l)], c = layout_.level_count[size_t(l)];
     if (c == 0) continue;
+    cones.push_back({GiKernel::kCones, 0, c * 16, l});
     updates.push_back({GiKernel::kUpdate, first, c, l});
     commits.push_back({GiKernel::kCommit, first, c, l});
     const int all = c + layout_.level_shadow[size_t(l)];
     if (config_.precombined) precombines.push_back({GiKernel::kPrecombine, first * 16, all * 16, l});
     t.surface_voxels += size_t(c);
   }
-  std::vector<GiStep> steps = std::move(updates);
+  std::vector<GiStep> steps = std::move(cones);
+  steps.insert(steps.end(), updates.begin(), updates.end());
   steps.insert(steps.end(), commits.begin(), commits.end());
   steps.insert(steps.end(), precombines.begin(), precombines.end());
   if (Status s = run_steps(steps); !s.ok()) return s;

@@ -29,8 +29,12 @@ const uint32_t kSpvUpdate[] =
 const uint32_t kSpvQuery[] =
 #include "gi_kernel4.spv.inc"
     ;
+const uint32_t kSpvCones[] =
+#include "gi_kernel5.spv.inc"
+    ;
 
-constexpr int kBindings = 13;
+constexpr int kBindings = 14;
+constexpr int kKernels = 5;  // GiKernel kAlpha .. kCones
 constexpr int kGroup = 64;         // local_size_x
 constexpr int kMaxGroups = 65535;  // per dispatch (the guaranteed minimum)
 
@@ -79,7 +83,7 @@ class VulkanGi final : public GiEngineBase {
   uint32_t queue_family_ = 0;
   VkDescriptorSetLayout set_layout_ = VK_NULL_HANDLE;
   VkPipelineLayout pipeline_layout_ = VK_NULL_HANDLE;
-  VkPipeline pipelines_[4] = {VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE, VK_NULL_HANDLE};
+  VkPipeline pipelines_[kKernels] = {};
   VkDescriptorPool pool_ = VK_NULL_HANDLE;
   VkDescriptorSet set_ = VK_NULL_HANDLE;
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
@@ -215,11 +219,10 @@ Status VulkanGi::make_pipelines() {
   plci.pPushConstantRanges = &push;
   if (VkResult r = vkCreatePipelineLayout(device_, &plci, nullptr, &pipeline_layout_); r != VK_SUCCESS)
     return vk_error("vkCreatePipelineLayout", r);
-  const std::pair<const uint32_t*, size_t> code[4] = {{kSpvAlpha, sizeof(kSpvAlpha)},
-                                                      {kSpvPrecombine, sizeof(kSpvPrecombine)},
-                                                      {kSpvUpdate, sizeof(kSpvUpdate)},
-                                                      {kSpvQuery, sizeof(kSpvQuery)}};
-  for (int i = 0; i < 4; ++i) {
+  const std::pair<const uint32_t*, size_t> code[kKernels] = {
+      {kSpvAlpha, sizeof(kSpvAlpha)}, {kSpvPrecombine, sizeof(kSpvPrecombine)}, {kSpvUpdate, sizeof(kSpvUpdate)},
+      {kSpvQuery, sizeof(kSpvQuery)}, {kSpvCones, sizeof(kSpvCones)}};
+  for (int i = 0; i < kKernels; ++i) {
     VkShaderModuleCreateInfo smci{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
     smci.codeSize = code[i].second;
     smci.pCode = code[i].first;
@@ -338,6 +341,7 @@ Status VulkanGi::upload(const GiLayout& layout) {
   if (st.ok() && !buffers_[10].buffer) st = make_buffer(10, 16, nullptr);
   if (st.ok()) st = make_buffer(11, bytes(layout.face_src), layout.face_src.data());
   if (st.ok()) st = make_buffer(12, bytes(layout.light_volume), layout.light_volume.data());
+  if (st.ok()) st = make_buffer(13, s * 48 * sizeof(glm::vec4), nullptr);
   if (!st.ok()) return st;
   write_descriptors();
   return {};

@@ -22,8 +22,9 @@ struct GiParams {
   glm::ivec4 iparams;  // x N, y K, z flags, w exact point lights
   glm::vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
   glm::ivec4 lo[kGiMaxLevels];
+  glm::ivec4 surf[kGiMaxLevels];  // per level x first updated surface voxel, y their count
 };
-static_assert(sizeof(GiParams) == 16 * (16 + 16 + 8 + 8 + 1 + 1 + 1 + 16));
+static_assert(sizeof(GiParams) == 16 * (16 + 16 + 8 + 8 + 1 + 1 + 1 + 16 + 16));
 
 struct GiPush {
   int first = 0;
@@ -32,9 +33,9 @@ struct GiPush {
   int pad = 0;
 };
 
-// The shaders' kernels (GI_KERNEL 1..4), and kCommit: the copy of
+// The shaders' kernels (GI_KERNEL 1..5), and kCommit: the copy of
 // light_next to light_prev for surface voxels [first, first + count).
-enum class GiKernel { kAlpha = 1, kPrecombine = 2, kUpdate = 3, kQuery = 4, kCommit = 5 };
+enum class GiKernel { kAlpha = 1, kPrecombine = 2, kUpdate = 3, kQuery = 4, kCones = 5, kCommit = 6 };
 
 // One step of the work a backend runs in a batch: `kernel` over `count`
 // items from `first`, with pc.level = level.

@@ -1,6 +1,6 @@
 #version 450
 // The GPU side of gi_bridge: bindings and entry points around gi_common.glsl.
-// Compiled four times with -DGI_KERNEL=1..4 (alpha, precombine, update, query).
+// Compiled five times with -DGI_KERNEL=1..5 (alpha, precombine, update, query, cones).
 layout(local_size_x = 64) in;
 
 #define GI_CONST const
@@ -18,6 +18,7 @@ layout(std140, binding = 0) uniform Params {
   ivec4 iparams;  // x N, y K, z flags, w exact point lights
   vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
   ivec4 lo[16];
+  ivec4 surf[16];  // per level x first updated surface voxel, y their count
 } P;
 
 layout(push_constant) uniform Push {
@@ -39,6 +40,7 @@ layout(std430, binding = 9) readonly buffer QIn { vec4 v[]; } qin_buf;
 layout(std430, binding = 10) writeonly buffer QOut { vec4 v[]; } qout_buf;
 layout(std430, binding = 11) readonly buffer FSrc { int v[]; } fsrc_buf;
 layout(std430, binding = 12) readonly buffer PLight { vec4 v[]; } plight_buf;
+layout(std430, binding = 13) buffer Cones { vec4 v[]; } cone_buf;
 
 float occ_load(int i) { return occ_buf.v[i]; }
 float alpha_load(int i) { return alpha_buf.v[i]; }
@@ -54,6 +56,8 @@ void pre_store(int i, vec4 v) { pre_buf.v[i] = v; }
 vec4 qin_load(int i) { return qin_buf.v[i]; }
 void qout_store(int i, vec4 v) { qout_buf.v[i] = v; }
 vec4 plight_load(int i) { return plight_buf.v[i]; }
+vec4 cone_load(int i) { return cone_buf.v[i]; }
+void cone_store(int i, vec4 v) { cone_buf.v[i] = v; }
 
 #include "gi_common.glsl"
 
@@ -65,7 +69,9 @@ void main() {
   kernel_precombine(gid);
 #elif GI_KERNEL == 3
   kernel_update(gid);
-#else
+#elif GI_KERNEL == 4
   kernel_query(gid);
+#else
+  kernel_cones(gid);
 #endif
 }

@@ -19,6 +19,7 @@
 //   light:  (s * 6 + face) * 3 + ch       ch 0 direct (D), 1 bounce (B1), 2 bounce 2 (B2)
 //   pre:    (s * 16 + dir) * 3 + ch       light of ch seen along dir, premultiplied by opacity
 //   plight: voxel                         injected point lights' emission density (kFlagLightVolume)
+//   cones:  (s * 16 + dir) * 3 + {0 sources, 1 D, 2 B1}   what the voxel centre's cone dir gathered
 
 // Cone half-angle of the 16 cones: solid angle 4 pi / 16 = pi / 4, so
 // cos = 7/8 and tan = sqrt(15) / 7.
@@ -363,10 +364,37 @@ void kernel_precombine(int gid) {
   for (int ch = 0; ch < 3; ++ch) pre_store((s * 16 + dir) * 3 + ch, vec4(blend_light(s, voxel, d, ch), 0.0f));
 }
 
-// Kernel 3: one pass of the lighting update of surface voxels pc.first ..
-// + pc.count: 16 cones from the voxel's centre; from the previous frame's
-// buffers, direct light (sky, point lights, emission), first bounce (from
-// D) and second bounce (from B1) all at once.
+// Where the voxel centre's cones start: one voxel out, or with the near/far
+// split (flag kFlagNearFar) at ts = P.fparams2.x voxels of the level.
+float far_start(int l) { return ((gi_flags() & kFlagNearFar) != 0 ? P.fparams2.x : 1.0f) * level_size(l); }
+
+// Kernel 5: the first half of a lighting update of level pc.level: the
+// cone along each direction from each updated surface voxel's centre, from
+// the previous frame's buffers; items pc.first .. + pc.count of 0 .. 16 c
+// (c = the level's updated voxels), direction-major. One invocation per
+// cone rather than per voxel gives a GPU 16 times the threads to fill its
+// cores (a level update has a few thousand surface voxels). Direction-major,
+// so that neighbouring invocations (SIMD lanes) march neighbouring voxels'
+// cones along one direction, which take alike steps, as the per-voxel
+// kernel's lanes did. Lavapipe times it as before (bench_gi timing).
+void kernel_cones(int gid) {
+  if (gid >= pc.count) return;
+  int item = pc.first + gid;
+  int c = P.surf[pc.level].y;
+  int s = P.surf[pc.level].x + item % c;
+  int dir = item / c;
+  ivec4 sp = surf_pos_load(s);
+  ConeResult cr = trace_cone(voxel_centre(sp.w, IXYZ(sp)), dir, sp.w, far_start(sp.w));
+  int slot = (s * 16 + dir) * 3;
+  cone_store(slot + 0, vec4(cr.src, 0.0f));
+  cone_store(slot + 1, vec4(cr.d, 0.0f));
+  cone_store(slot + 2, vec4(cr.b1, 0.0f));
+}
+
+// Kernel 3: the second half of a lighting update of surface voxels
+// pc.first .. + pc.count, after kernel 5 traced their 16 cones: direct
+// light (sky, point lights, emission), first bounce (from D) and second
+// bounce (from B1) of each face, all at once.
 // Near/far split (flag kFlagNearFar, split distance ts = P.fparams2.x voxels
 // of the level): the 16 cones from the voxel's centre start at ts (the
 // "far" part, shared by the six faces, as the talk's far cones traced once
@@ -383,19 +411,10 @@ void kernel_update(int gid) {
   vec3 apex = voxel_centre(l, IXYZ(sp));
   bool split = (gi_flags() & kFlagNearFar) != 0;
   float vs = level_size(l);
-  float ts = split ? P.fparams2.x * vs : vs;
-  vec3 src[16];
-  vec3 gd[16];
-  vec3 gb1[16];
+  float ts = far_start(l);
   // One shadow cone per light from the centre, shared by the faces as the
   // cones are (6 times fewer marches than per face; the same error).
   LightVisibility vis = light_visibility(apex, l, vs);
-  for (int i = 0; i < 16; ++i) {
-    ConeResult cr = trace_cone(apex, i, l, ts);
-    src[i] = cr.src;
-    gd[i] = cr.d;
-    gb1[i] = cr.b1;
-  }
   for (int f = 0; f < 6; ++f) {
     vec4 albedo = attr_load((s * 6 + f) * 3 + 0);
     vec3 n = XYZ(attr_load((s * 6 + f) * 3 + 1));
@@ -413,15 +432,18 @@ void kernel_update(int gid) {
     for (int i = 0; i < 16; ++i) {
       float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
       if (c <= 0.0f) continue;
+      vec3 src = XYZ(cone_load((s * 16 + i) * 3 + 0));
+      vec3 gd = XYZ(cone_load((s * 16 + i) * 3 + 1));
+      vec3 gb1 = XYZ(cone_load((s * 16 + i) * 3 + 2));
       if (split) {
         ConeResult nr = trace_cone_range(apex_f, i, l, 0.5f * vs, ts - 0.5f * vs * c);
-        es += c * (nr.src + nr.transmittance * src[i]);
-        ed += c * (nr.d + nr.transmittance * gd[i]);
-        eb += c * (nr.b1 + nr.transmittance * gb1[i]);
+        es += c * (nr.src + nr.transmittance * src);
+        ed += c * (nr.d + nr.transmittance * gd);
+        eb += c * (nr.b1 + nr.transmittance * gb1);
       } else {
-        es += c * src[i];
-        ed += c * gd[i];
-        eb += c * gb1[i];
+        es += c * src;
+        ed += c * gd;
+        eb += c * gb1;
       }
     }
     vec3 rho = XYZ(albedo) / wsum;
