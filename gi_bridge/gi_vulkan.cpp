@@ -3,10 +3,10 @@
 // embedded. Every buffer is host-visible and coherent, device-local too
 // where the device has such memory (lavapipe: all of it; a discrete GPU:
 // its BAR heap, falling back to host memory when that is full). A lighting
-// update is one command buffer (the levels' updates, the copies of the new
-// light over the old, the precombines, with a barrier between kinds), one
-// submit waited on with a fence; two GPU timestamps around its work give
-// GiTimings::device_seconds.
+// update is one command buffer (the levels' cones, their updates, the copies
+// of the new light over the old, the precombines, with a barrier between
+// kinds), one submit waited on with a fence; two GPU timestamps around its
+// work give GiTimings::device_seconds.
 #include <cstring>
 #include <vector>
 
