@@ -103,8 +103,11 @@ PathTracer::Hit PathTracer::intersect(const glm::dvec3& origin, const glm::vec3&
 
 namespace {
 
-// Irradiance from the point lights at x (normal n), with shadow rays.
-glm::vec3 point_light_irradiance(const PathTracer::Impl& im, const glm::dvec3& x, const glm::vec3& n) {
+// Irradiance from the point lights at surface point x (normal n): distance
+// and cosine from x itself, shadow rays from `origin` (x lifted off the
+// surface by the ray offset, which would otherwise bias 1 / r^2).
+glm::vec3 point_light_irradiance(const PathTracer::Impl& im, const glm::dvec3& x, const glm::dvec3& origin,
+                                 const glm::vec3& n) {
   glm::vec3 e(0.0f);
   for (const PointLight& l : im.lights.points) {
     const glm::dvec3 to = l.position - x;
@@ -113,9 +116,12 @@ glm::vec3 point_light_irradiance(const PathTracer::Impl& im, const glm::dvec3& x
     const glm::vec3 w = glm::vec3(to / r);
     const float c = glm::dot(n, w);
     if (c <= 0.0f) continue;
+    const glm::dvec3 from_origin = l.position - origin;
+    const double r_origin = glm::length(from_origin);
+    if (r_origin <= 0.0) continue;
     RTCIntersectContext ctx;
     rtcInitIntersectContext(&ctx);
-    RTCRay ray = make_ray(x, w, float(r)).ray;
+    RTCRay ray = make_ray(origin, glm::vec3(from_origin / r_origin), float(r_origin)).ray;
     rtcOccluded1(im.scene, &ctx, &ray);
     if (ray.tfar < 0.0f) continue;  // occluded
     e += l.intensity * (c / float(r * r));
@@ -128,10 +134,22 @@ glm::vec3 point_light_irradiance(const PathTracer::Impl& im, const glm::dvec3& x
 Status PathTracer::irradiance(std::span<const glm::dvec3> points, std::span<const glm::vec3> normals, int bounces,
                               std::span<glm::vec3> out, const PathTraceConfig& config) const {
   if (normals.size() != points.size() || out.size() != points.size())
-    return Status(ErrorCode::kInvalidArgument, "path tracer: points, normals and outputs differ in size");
+    return Status(ErrorCode::kInvalidArgument, "path tracer: points, normals and outputs differ in size (" +
+                                                   std::to_string(points.size()) + ", " + std::to_string(normals.size()) +
+                                                   ", " + std::to_string(out.size()) + ")");
   if (bounces < 1 || bounces > 16) return Status(ErrorCode::kInvalidArgument, "path tracer: bounces " + std::to_string(bounces) + " must be 1 .. 16");
   if (config.samples < 1 || config.samples > (1 << 20))
     return Status(ErrorCode::kInvalidArgument, "path tracer: samples " + std::to_string(config.samples) + " must be 1 .. 2^20");
+  if (!(config.ray_offset >= 0.0 && std::isfinite(config.ray_offset)))
+    return Status(ErrorCode::kInvalidArgument,
+                  "path tracer: ray_offset " + std::to_string(config.ray_offset) + " must be finite and >= 0");
+  for (size_t i = 0; i < points.size(); ++i) {
+    if (glm::any(glm::isnan(points[i])) || glm::any(glm::isinf(points[i])))
+      return Status(ErrorCode::kInvalidArgument, "path tracer: point " + std::to_string(i) + " is not finite");
+    const float len = glm::length(normals[i]);
+    if (!(len > 0.0f && std::isfinite(len)))
+      return Status(ErrorCode::kInvalidArgument, "path tracer: normal " + std::to_string(i) + " is zero or not finite");
+  }
   const Impl& im = *impl_;
   tbb::parallel_for(size_t(0), points.size(), [&](size_t q) {
     std::mt19937 rng(config.seed * 2654435761u + uint32_t(q));
@@ -152,14 +170,15 @@ Status PathTracer::irradiance(std::span<const glm::dvec3> points, std::span<cons
         if (k <= bounces - 1) l += beta * m.emission;
         if (k + 1 > bounces) break;
         beta *= m.albedo;
-        p = p + h.distance * glm::dvec3(w) + config.ray_offset * glm::dvec3(h.normal);
+        const glm::dvec3 hit = p + h.distance * glm::dvec3(w);
+        p = hit + config.ray_offset * glm::dvec3(h.normal);
         n = h.normal;
-        l += beta * point_light_irradiance(im, p, n) * (1.0f / std::numbers::pi_v<float>);
+        l += beta * point_light_irradiance(im, hit, p, n) * (1.0f / std::numbers::pi_v<float>);
         if (beta.x + beta.y + beta.z <= 0.0f) break;
       }
       sum += l;
     }
-    out[q] = sum * (std::numbers::pi_v<float> / float(config.samples)) + point_light_irradiance(im, p0, n0);
+    out[q] = sum * (std::numbers::pi_v<float> / float(config.samples)) + point_light_irradiance(im, points[q], p0, n0);
   });
   return {};
 }
