@@ -2,7 +2,9 @@
 // with normals on the contoured mesh (Embree 3), with the same materials
 // (albedo, emission by triangle material), sky (SkyLight::radiance) and
 // point lights as the cone tracer. Lambertian surfaces, cosine-weighted
-// sampling, point lights by next-event estimation with a shadow ray.
+// sampling, point lights by next-event estimation with a shadow ray (from
+// the point lifted by ray_offset; distance and cosine from the point).
+// tests/gi/test_path_trace.cpp checks it on scenes with exact answers.
 //
 // Bounces are counted as in GiEngine::irradiance: with `bounces` = b, sky
 // and point light reach the point after at most b reflections, emission
