@@ -42,14 +42,14 @@ struct Scene {
   GiLights lights;
 };
 
-Scene lit_room() {
+Scene lit_room(int levels = 3, int resolution = 16) {
   std::vector<GiBox> boxes = test::closed_room(0);
   boxes[5].hi.z = 0.0;                                // the +y wall open above z = 0
   boxes[2].material = 3;                               // red -x wall
   boxes[3].material = 4;                               // green +x wall
   boxes.push_back({{-0.4, -0.4, 0.6}, {0.4, 0.4, 1.0}, 2});  // emitter in the ceiling
   World w = test::build_boxes(boxes);
-  Cascades c = test::make_cascades(w, glm::dvec3(0.0));
+  Cascades c = test::make_cascades(w, glm::dvec3(0.0), levels, resolution);
   GiLights l;
   l.sky = SkyLight::gradient(glm::vec3(0.6f, 0.8f, 1.2f), glm::vec3(1.0f), glm::vec3(0.2f));
   l.points.push_back({glm::dvec3(0.4, -0.3, -0.2), glm::vec3(1.5f, 1.2f, 0.8f)});
@@ -57,10 +57,10 @@ Scene lit_room() {
 }
 
 // via_set_lights: load with no light, then set_lights(the scene's).
-void expect_engines_agree(const GiConfig& config, int passes, bool via_set_lights = false) {
+void expect_engines_agree(const GiConfig& config, int passes, bool via_set_lights = false,
+                          const Scene& scene = lit_room()) {
   auto gpu = vulkan_or_skip(config);
   if (!gpu) GTEST_SKIP() << "no Vulkan device";
-  const Scene scene = lit_room();
   auto cpu = make_cpu_gi(config);
   for (GiEngine* g : {gpu.get(), cpu.get()}) {
     ASSERT_TRUE(g->load(scene.cascades, via_set_lights ? GiLights{} : scene.lights).ok());
@@ -129,6 +129,15 @@ TEST(GiVulkan, MatchesTheCpuReferenceAfterSetLights) {
   GiConfig c;
   c.light_volume = true;
   expect_engines_agree(c, 3, true);
+}
+
+// Kernels over more items than one dispatch takes (64 x 65535): the
+// per-direction opacities of 4 levels of 64^3 voxels are 16.8 M items, so
+// the engine records them as 4 dispatches, each with its own first item.
+TEST(GiVulkan, MatchesTheCpuReferenceWhenAKernelSpansSeveralDispatches) {
+  const Scene big = lit_room(4, 64);
+  ASSERT_GT(size_t(4) * 64 * 64 * 64 * 16, size_t(64) * 65535);
+  expect_engines_agree(GiConfig{}, 2, false, big);
 }
 
 TEST(GiVulkan, ClosedRoomIsBlackInside) {
