@@ -182,6 +182,18 @@ Result<Cascades> bench_cascades(const Scene& s, const MaterialTable& materials) 
   return cas;
 }
 
+// The CPU engine, or the Vulkan one (its device's name into *device);
+// null, with a message, when no Vulkan device exists.
+std::unique_ptr<GiEngine> make_engine(bool cpu, const GiConfig& config, std::string* device) {
+  if (cpu) return make_cpu_gi(config);
+  Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi(config, device);
+  if (!gi.ok()) {
+    std::printf("no Vulkan device: %s\n", gi.status().message().c_str());
+    return nullptr;
+  }
+  return std::move(gi).value();
+}
+
 void run(const Scene& s, int points, int paths) {
   std::printf("\n## %s\n", s.name.c_str());
   Result<Cascades> cas = bench_cascades(s, s.materials);
@@ -207,17 +219,8 @@ void run(const Scene& s, int points, int paths) {
     GiConfig gc;
     gc.precombined = pre;
     gc.near_far = split;
-    std::unique_ptr<GiEngine> engine;
-    if (cpu) {
-      engine = make_cpu_gi(gc);
-    } else {
-      Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi(gc, &device);
-      if (!gi.ok()) {
-        std::printf("no Vulkan device: %s\n", gi.status().message().c_str());
-        return;
-      }
-      engine = std::move(gi).value();
-    }
+    std::unique_ptr<GiEngine> engine = make_engine(cpu, gc, &device);
+    if (!engine) return;
     GiEngine& g = *engine;
     auto t0 = Clock::now();
     if (!g.load(cas.value(), s.lights).ok()) return;
@@ -330,14 +333,8 @@ void timing(const Scene& s) {
   if (!cas.ok()) return;
   for (int cpu = 0; cpu < 2; ++cpu) {
     std::string device = "cpu";
-    std::unique_ptr<GiEngine> engine;
-    if (cpu) {
-      engine = make_cpu_gi();
-    } else {
-      Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi({}, &device);
-      if (!gi.ok()) continue;
-      engine = std::move(gi).value();
-    }
+    std::unique_ptr<GiEngine> engine = make_engine(cpu, {}, &device);
+    if (!engine) continue;
     if (!engine->load(cas.value(), s.lights).ok() || !engine->update_all(3).ok()) return;
     std::vector<double> wall, dev;
     for (int r = 0; r < 9; ++r) {

@@ -327,7 +327,7 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
   if (Status s = run_steps(steps); !s.ok()) return s;
   t.levels_updated = int(levels.size());
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  t.device_seconds = steps.empty() ? 0.0 : last_device_seconds_;
+  t.device_seconds = last_device_seconds_;
   return t;
 }
 

@@ -72,7 +72,8 @@ class VulkanGi final : public GiEngineBase {
   void free_buffer(Buffer& b);
   void write_descriptors();
   Status make_pipelines();
-  Status make_timestamps();
+  // The chosen queue family's timestampValidBits and the device's timestampPeriod.
+  Status make_timestamps(uint32_t bits, float period_ns);
   double device_seconds() const;
   void destroy();
 
@@ -121,6 +122,8 @@ Status VulkanGi::init(std::string* device_name) {
   std::vector<VkPhysicalDevice> devices(count);
   vkEnumeratePhysicalDevices(instance_, &count, devices.data());
   int best_rank = 99;
+  uint32_t timestamp_bits = 0;
+  float timestamp_period = 1.0f;
   for (VkPhysicalDevice d : devices) {
     VkPhysicalDeviceProperties props;
     vkGetPhysicalDeviceProperties(d, &props);
@@ -134,6 +137,8 @@ Status VulkanGi::init(std::string* device_name) {
         best_rank = device_rank(props.deviceType);
         physical_ = d;
         queue_family_ = q;
+        timestamp_bits = qs[q].timestampValidBits;
+        timestamp_period = props.limits.timestampPeriod;
         if (device_name) *device_name = props.deviceName;
         break;
       }
@@ -163,21 +168,14 @@ Status VulkanGi::init(std::string* device_name) {
     return vk_error("vkAllocateCommandBuffers", r);
   VkFenceCreateInfo fci{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
   if (VkResult r = vkCreateFence(device_, &fci, nullptr, &fence_); r != VK_SUCCESS) return vk_error("vkCreateFence", r);
-  if (Status s = make_timestamps(); !s.ok()) return s;
+  if (Status s = make_timestamps(timestamp_bits, timestamp_period); !s.ok()) return s;
   return make_pipelines();
 }
 
-Status VulkanGi::make_timestamps() {
-  uint32_t nq = 0;
-  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, nullptr);
-  std::vector<VkQueueFamilyProperties> qs(nq);
-  vkGetPhysicalDeviceQueueFamilyProperties(physical_, &nq, qs.data());
-  const uint32_t bits = qs[queue_family_].timestampValidBits;
+Status VulkanGi::make_timestamps(uint32_t bits, float period_ns) {
   if (bits == 0) return {};  // GiTimings::device_seconds stays -1
-  VkPhysicalDeviceProperties props;
-  vkGetPhysicalDeviceProperties(physical_, &props);
   timestamp_mask_ = bits >= 64 ? ~uint64_t(0) : (uint64_t(1) << bits) - 1;
-  timestamp_period_ns_ = double(props.limits.timestampPeriod);
+  timestamp_period_ns_ = double(period_ns);
   VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
   qpi.queryCount = 2;

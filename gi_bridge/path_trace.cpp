@@ -9,6 +9,8 @@
 #include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>
 
+#include "ldc/detail/vec_text.h"
+
 namespace ldc {
 
 struct PathTracer::Impl {
@@ -144,8 +146,9 @@ Status PathTracer::irradiance(std::span<const glm::dvec3> points, std::span<cons
     return Status(ErrorCode::kInvalidArgument,
                   "path tracer: ray_offset " + std::to_string(config.ray_offset) + " must be finite and >= 0");
   for (size_t i = 0; i < points.size(); ++i) {
-    if (glm::any(glm::isnan(points[i])) || glm::any(glm::isinf(points[i])))
-      return Status(ErrorCode::kInvalidArgument, "path tracer: point " + std::to_string(i) + " is not finite");
+    if (!detail::is_finite(points[i]))
+      return Status(ErrorCode::kInvalidArgument,
+                    "path tracer: point " + std::to_string(i) + " " + detail::vec_text(points[i]) + " is not finite");
     const float len = glm::length(normals[i]);
     if (!(len > 0.0f && std::isfinite(len)))
       return Status(ErrorCode::kInvalidArgument, "path tracer: normal " + std::to_string(i) + " is zero or not finite");
