@@ -1,5 +1,8 @@
 #include "ldc/status.h"
 
+#include <cstdio>
+#include <cstdlib>
+
 namespace ldc {
 
 const char* error_code_name(ErrorCode code) {
@@ -21,5 +24,15 @@ std::string Status::to_string() const {
   if (ok()) return "ok";
   return std::string(error_code_name(code_)) + ": " + message_;
 }
+
+namespace detail {
+
+void abort_on_error_result(const Status& status, const char* what) {
+  std::fprintf(stderr, "ldc: %s on an error Result: %s\n", what, status.to_string().c_str());
+  std::fflush(stderr);
+  std::abort();
+}
+
+}  // namespace detail
 
 }  // namespace ldc

@@ -45,22 +45,63 @@ class [[nodiscard]] Status {
   std::string message_;
 };
 
-// Either a value or an error Status. Access to value() on an error is a bug (asserts).
+namespace detail {
+// Prints "ldc: <what> on an error Result: <status>" to stderr and aborts, in
+// every build (NDEBUG or not): reading the value of a failed call is a bug in
+// the caller, and undefined behaviour would hide it.
+[[noreturn]] void abort_on_error_result(const Status& status, const char* what);
+}  // namespace detail
+
+// Either a value or an error Status.
+//
+//   Result<World> w = load_world("a.ldc");
+//   if (!w) return w.status();      // explicit operator bool: ok()
+//   use(*w); w->chunk_size();       // the value, as with std::optional
+//
+// Reading the value of an error (value(), *, ->) aborts with the status
+// message in every build; value_or() gives a fallback instead. A Result made
+// from an ok Status (a bug in the callee) holds the error kInternal.
 template <class T>
 class [[nodiscard]] Result {
  public:
   Result(T value) : value_(std::move(value)) {}  // NOLINT: implicit by design
-  Result(Status status) : status_(std::move(status)) {}  // NOLINT
+  Result(Status status) : status_(std::move(status)) {  // NOLINT
+    if (status_.ok()) status_ = Status(ErrorCode::kInternal, "a Result was made from an ok Status without a value");
+  }
 
   bool ok() const { return value_.has_value(); }
+  explicit operator bool() const { return ok(); }
   const Status& status() const { return status_; }
-  T& value() & { return *value_; }
-  const T& value() const& { return *value_; }
-  T&& value() && { return std::move(*value_); }
-  T* operator->() { return &*value_; }
-  const T* operator->() const { return &*value_; }
+
+  T& value() & { return checked("value()"); }
+  const T& value() const& { return checked("value()"); }
+  T&& value() && { return std::move(checked("value()")); }
+  T& operator*() & { return checked("operator*"); }
+  const T& operator*() const& { return checked("operator*"); }
+  T&& operator*() && { return std::move(checked("operator*")); }
+  T* operator->() { return &checked("operator->"); }
+  const T* operator->() const { return &checked("operator->"); }
+
+  // The value, or `fallback` when this holds an error.
+  template <class U>
+  T value_or(U&& fallback) const& {
+    return ok() ? *value_ : static_cast<T>(std::forward<U>(fallback));
+  }
+  template <class U>
+  T value_or(U&& fallback) && {
+    return ok() ? std::move(*value_) : static_cast<T>(std::forward<U>(fallback));
+  }
 
  private:
+  T& checked(const char* what) {
+    if (!value_) detail::abort_on_error_result(status_, what);
+    return *value_;
+  }
+  const T& checked(const char* what) const {
+    if (!value_) detail::abort_on_error_result(status_, what);
+    return *value_;
+  }
+
   std::optional<T> value_;
   Status status_;
 };
