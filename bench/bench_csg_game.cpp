@@ -57,7 +57,7 @@ void time_edit(ldc::WorldEditor& ed, ldc::ChunkedMesh& meshes, const GameEdit& e
     auto t0 = std::chrono::steady_clock::now();
     ldc::EditReceipt receipt = ed.apply(e.brush, e.op).value();
     auto t1 = std::chrono::steady_clock::now();
-    *remeshed = meshes.update(ed.world(), ed.take_dirty()).value();
+    *remeshed = meshes.update(ed.world(), ed.take_dirty()).value().chunks_remeshed;
     auto t2 = std::chrono::steady_clock::now();
     alone.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
     both.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());

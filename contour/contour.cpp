@@ -42,12 +42,6 @@ Status check_contour_config(const ContourConfig& c) {
 
 namespace {
 
-bool chunk_less(const glm::ivec3& a, const glm::ivec3& b) {
-  if (a.z != b.z) return a.z < b.z;
-  if (a.y != b.y) return a.y < b.y;
-  return a.x < b.x;
-}
-
 // Nothing to mesh when the chunk and all 26 around it are uniform and alike:
 // its region (the chunk plus a margin smaller than a chunk) holds no surface.
 bool chunk_is_quiet(const World& w, const glm::ivec3& ch) {
@@ -106,7 +100,7 @@ Result<std::vector<ChunkMesh>> mesh_chunks(const World& w, const std::vector<glm
 // The boxes to re-mesh for a dirty list: each dirty node box grown to the
 // cells and edges it can affect, overlapping boxes merged (an edit's boxes
 // come one per chunk and meet).
-std::vector<std::pair<glm::ivec3, glm::ivec3>> patch_boxes(const std::vector<DirtyChunk>& dirty, int relax) {
+std::vector<std::pair<glm::ivec3, glm::ivec3>> patch_boxes(std::span<const DirtyChunk> dirty, int relax) {
   std::vector<std::pair<glm::ivec3, glm::ivec3>> boxes;
   for (const DirtyChunk& d : dirty) {
     glm::ivec3 lo, hi;
@@ -129,7 +123,42 @@ std::vector<std::pair<glm::ivec3, glm::ivec3>> patch_boxes(const std::vector<Dir
   return boxes;
 }
 
+// The chunks a cell box [lo, hi) lies in (hi exclusive).
+void chunks_of_box(const glm::ivec3& lo, const glm::ivec3& hi, int chunk_size, std::vector<glm::ivec3>& out) {
+  glm::ivec3 first, last;
+  for (int a = 0; a < 3; ++a) {
+    first[a] = detail::floor_div(lo[a], chunk_size);
+    last[a] = detail::floor_div(hi[a] - 1, chunk_size);
+  }
+  for (int z = first.z; z <= last.z; ++z)
+    for (int y = first.y; y <= last.y; ++y)
+      for (int x = first.x; x <= last.x; ++x) out.emplace_back(x, y, z);
+}
+
+void sort_unique_chunks(std::vector<glm::ivec3>& chunks) {
+  std::sort(chunks.begin(), chunks.end(), chunk_order_less);
+  chunks.erase(std::unique(chunks.begin(), chunks.end()), chunks.end());
+}
+
+bool same_chunk_mesh(const ChunkMesh& a, const ChunkMesh& b) {
+  return a.own_vertices == b.own_vertices && a.vertex_cell == b.vertex_cell && a.mesh.positions == b.mesh.positions &&
+         a.mesh.normals == b.mesh.normals && a.mesh.vertex_material == b.mesh.vertex_material &&
+         a.mesh.triangles == b.mesh.triangles && a.mesh.triangle_material == b.mesh.triangle_material;
+}
+
 }  // namespace
+
+std::vector<glm::ivec3> chunks_a_remesh_may_change(std::span<const DirtyChunk> dirty, const ContourConfig& config,
+                                                   int chunk_size) {
+  std::vector<glm::ivec3> chunks;
+  for (const DirtyChunk& d : dirty) {
+    glm::ivec3 lo, hi;
+    detail::patch_box(d.node_lo, d.node_hi, config.relax_iterations, &lo, &hi);
+    chunks_of_box(lo, hi, chunk_size, chunks);
+  }
+  sort_unique_chunks(chunks);
+  return chunks;
+}
 
 Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk, const ContourConfig& config,
                                 ContourStats* stats) {
@@ -156,12 +185,20 @@ Status ChunkedMesh::build(const World& world, Context* ctx) {
   if (!r.ok()) return r.status();
   chunks_ = std::move(r.value());
   chunk_size_ = world.chunk_size();
+  ++version_;
+  for (ChunkMesh& m : chunks_) m.version = version_;
   stats.seconds = timer.seconds();
   stats_ = stats;
   return {};
 }
 
-Result<size_t> ChunkedMesh::update(const World& world, const std::vector<glm::ivec3>& changed, Context* ctx) {
+const ChunkMesh* ChunkedMesh::find(const glm::ivec3& chunk) const {
+  auto it = std::lower_bound(chunks_.begin(), chunks_.end(), chunk,
+                             [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_order_less(m.chunk, k); });
+  return it != chunks_.end() && it->chunk == chunk ? &*it : nullptr;
+}
+
+Result<MeshUpdate> ChunkedMesh::update(const World& world, std::span<const glm::ivec3> changed, Context* ctx) {
   // Anything in the chunk's rays may have changed: its nodes and the edges up to the next chunk's first node.
   const int c = world.chunk_size();
   std::vector<DirtyChunk> whole;
@@ -170,52 +207,60 @@ Result<size_t> ChunkedMesh::update(const World& world, const std::vector<glm::iv
   return update(world, whole, ctx);
 }
 
-Result<size_t> ChunkedMesh::update(const World& world, const std::vector<DirtyChunk>& dirty, Context* ctx) {
+Result<MeshUpdate> ChunkedMesh::update(const World& world, std::span<const DirtyChunk> dirty, Context* ctx) {
   if (world.chunk_size() != chunk_size_) {
     return Status(ErrorCode::kInvalidArgument, "contour: update with a world of another chunk size");
   }
   ScopedTimer timer(ctx, "contour update");
   ContourStats stats;
-  size_t spliced = 0;
+  MeshUpdate result;
+  std::vector<glm::ivec3> changed;
   for (const auto& [lo, hi] : patch_boxes(dirty, config_.relax_iterations)) {
     if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "contour: cancelled");
     detail::MeshPatch patch = detail::mesh_patch(world, config_, lo, hi, stats);
-    spliced += splice(patch);
+    result.chunks_remeshed += splice(patch, changed);
+  }
+  sort_unique_chunks(changed);
+  if (!changed.empty()) ++version_;
+  for (const glm::ivec3& ch : changed) {
+    auto it = std::lower_bound(chunks_.begin(), chunks_.end(), ch,
+                               [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_order_less(m.chunk, k); });
+    const bool exists = it != chunks_.end() && it->chunk == ch;
+    if (exists) it->version = version_;
+    result.changes.push_back({ch, exists ? version_ : 0});
   }
   stats.seconds = timer.seconds();
   stats_.add_counts(stats);
-  return spliced;
+  return result;
 }
 
-// Splices a patch into every chunk mesh whose cells or edges it overlaps, in parallel.
-size_t ChunkedMesh::splice(const detail::MeshPatch& patch) {
+// Splices a patch into every chunk mesh whose cells or edges it overlaps, in
+// parallel; appends the chunks whose mesh content changed to `changed`.
+size_t ChunkedMesh::splice(const detail::MeshPatch& patch, std::vector<glm::ivec3>& changed) {
   const int c = chunk_size_;
-  glm::ivec3 first, last;
-  for (int a = 0; a < 3; ++a) {
-    first[a] = detail::floor_div(patch.lo[a], c);
-    last[a] = detail::floor_div(patch.hi[a] - 1, c);
-  }
   std::vector<glm::ivec3> targets;
-  for (int z = first.z; z <= last.z; ++z)
-    for (int y = first.y; y <= last.y; ++y)
-      for (int x = first.x; x <= last.x; ++x) targets.emplace_back(x, y, z);
-  auto less = [](const ChunkMesh& a, const ChunkMesh& b) { return chunk_less(a.chunk, b.chunk); };
+  chunks_of_box(patch.lo, patch.hi, c, targets);
+  auto less = [](const ChunkMesh& a, const ChunkMesh& b) { return chunk_order_less(a.chunk, b.chunk); };
   const size_t kept = chunks_.size();  // the sorted part; chunks new to the mesh are appended below
-  auto find = [&](const glm::ivec3& ch) -> ChunkMesh* {
+  auto find_kept = [&](const glm::ivec3& ch) -> ChunkMesh* {
     auto end = chunks_.begin() + long(kept);
     auto it = std::lower_bound(chunks_.begin(), end, ch,
-                               [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_less(m.chunk, k); });
+                               [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_order_less(m.chunk, k); });
     return it != end && it->chunk == ch ? &*it : nullptr;
   };
   std::vector<ChunkMesh> spliced(targets.size());
+  std::vector<char> differs(targets.size(), 0);
   tbb::parallel_for(size_t{0}, targets.size(), [&](size_t i) {
-    const ChunkMesh* old = find(targets[i]);
+    const ChunkMesh* old = find_kept(targets[i]);
     spliced[i] = detail::splice_patch(old ? *old : ChunkMesh{}, patch, targets[i], c);
+    if (old) spliced[i].version = old->version;
+    differs[i] = old ? !same_chunk_mesh(*old, spliced[i]) : !spliced[i].mesh.positions.empty();
   });
   // Replace in place; chunks new to the mesh are merged in, and chunks left
   // without vertices dropped, keeping chunks_ sorted.
   for (size_t i = 0; i < targets.size(); ++i) {
-    if (ChunkMesh* old = find(targets[i])) *old = std::move(spliced[i]);
+    if (differs[i]) changed.push_back(targets[i]);
+    if (ChunkMesh* old = find_kept(targets[i])) *old = std::move(spliced[i]);
     else if (!spliced[i].mesh.positions.empty()) chunks_.push_back(std::move(spliced[i]));
   }
   std::inplace_merge(chunks_.begin(), chunks_.begin() + long(kept), chunks_.end(), less);
@@ -236,10 +281,10 @@ ContourMesh ChunkedMesh::assemble() const {
     glm::ivec3 owner(detail::floor_div(cell.x, chunk_size_), detail::floor_div(cell.y, chunk_size_),
                      detail::floor_div(cell.z, chunk_size_));
     auto it = std::lower_bound(chunks_.begin(), chunks_.end(), owner,
-                               [](const ChunkMesh& m, const glm::ivec3& c) { return chunk_less(m.chunk, c); });
+                               [](const ChunkMesh& m, const glm::ivec3& c) { return chunk_order_less(m.chunk, c); });
     const ChunkMesh& m = *it;  // the owner always has this vertex: its cell has a sign change
     auto begin = m.vertex_cell.begin(), end = begin + long(m.own_vertices);
-    auto v = std::lower_bound(begin, end, cell, [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_less(a, b); });
+    auto v = std::lower_bound(begin, end, cell, [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_order_less(a, b); });
     return uint32_t(vbase[size_t(it - chunks_.begin())] + size_t(v - begin));
   };
   ContourMesh out;

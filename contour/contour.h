@@ -34,6 +34,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -140,7 +141,31 @@ struct ChunkMesh {
   ContourMesh mesh;
   size_t own_vertices = 0;          // mesh.positions[0 .. own_vertices) belong to this chunk
   std::vector<glm::ivec3> vertex_cell;  // the lattice cell of every vertex
+  // ChunkedMesh: the build or update that last changed this mesh (see
+  // ChunkedMesh::version); an engine re-uploads a chunk whose version moved.
+  uint64_t version = 0;
 };
+
+// What a ChunkedMesh::update changed: a chunk mesh whose content differs from
+// before (version > 0: its new ChunkMesh::version) or that no longer exists
+// (version 0: the chunk has no surface now; drop its draw call).
+struct ChunkMeshChange {
+  glm::ivec3 chunk{0};
+  uint64_t version = 0;
+  bool removed() const { return version == 0; }
+};
+
+struct MeshUpdate {
+  std::vector<ChunkMeshChange> changes;  // sorted by chunk_order_less, each chunk once
+  size_t chunks_remeshed = 0;            // chunk meshes re-spliced, changed or not
+};
+
+// The chunks whose meshes an update for `dirty` may change: every chunk a
+// re-mesh box (the dirty node box grown by relax_iterations + 1 cells, plus
+// the quads around it) overlaps, sorted by chunk_order_less. Meshes outside
+// them are untouched; an engine can mark these before re-meshing.
+std::vector<glm::ivec3> chunks_a_remesh_may_change(std::span<const DirtyChunk> dirty, const ContourConfig& config,
+                                                   int chunk_size);
 
 // Meshes one chunk. Chunks that are empty or solid, and whose neighbours
 // along the low side are too, produce an empty mesh without reading a ray.
@@ -156,23 +181,30 @@ class ChunkedMesh {
   // Re-meshes the given chunks and the margin of cells around them that
   // their change can reach (see the next overload); leaves every other chunk
   // mesh as it was.
-  Result<size_t> update(const World& world, const std::vector<glm::ivec3>& changed_chunks,
-                        Context* ctx = nullptr);
+  Result<MeshUpdate> update(const World& world, std::span<const glm::ivec3> changed_chunks,
+                            Context* ctx = nullptr);
   // Re-meshes only the cells whose vertices the dirty boxes can move (each
   // box grown by relax_iterations + 1 cells) and the quads around them, and
   // splices them into the chunk meshes they fall in; the result equals a
-  // fresh build. Returns how many chunk meshes were spliced.
-  Result<size_t> update(const World& world, const std::vector<DirtyChunk>& dirty, Context* ctx = nullptr);
+  // fresh build. Returns the chunk meshes whose content changed or that were
+  // removed; on error (cancelled) the meshes spliced so far stay spliced.
+  Result<MeshUpdate> update(const World& world, std::span<const DirtyChunk> dirty, Context* ctx = nullptr);
   const std::vector<ChunkMesh>& chunks() const { return chunks_; }
+  // The chunk's mesh, or null when it has none (no surface, or not built).
+  const ChunkMesh* find(const glm::ivec3& chunk) const;
+  const ContourConfig& config() const { return config_; }
+  // Counts builds and updates that changed something; starts at 0 (nothing built).
+  uint64_t version() const { return version_; }
   // One welded mesh: every vertex once, chunk by chunk, in a fixed order.
   ContourMesh assemble() const;
   const ContourStats& stats() const { return stats_; }
 
  private:
-  size_t splice(const detail::MeshPatch& patch);
+  size_t splice(const detail::MeshPatch& patch, std::vector<glm::ivec3>& changed);
 
   ContourConfig config_;
   int chunk_size_ = 32;
+  uint64_t version_ = 0;
   std::vector<ChunkMesh> chunks_;  // non-empty chunk meshes, sorted by chunk (z, y, x)
   ContourStats stats_;
 };

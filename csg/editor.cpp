@@ -29,16 +29,10 @@ namespace {
 
 // Chunk coordinates are within +-2^17 (kMaxNodeCoordinate / kMinChunkSize):
 // 21 bits each, offset to be unsigned, make a unique key that orders chunks
-// by (z, y, x) as chunk_less does.
+// by (z, y, x) as chunk_order_less does.
 uint64_t chunk_key(const glm::ivec3& c) {
   auto bits = [](int v) { return uint64_t(uint32_t(v + (1 << 20))) & 0x1FFFFFu; };
   return bits(c.x) | (bits(c.y) << 21) | (bits(c.z) << 42);
-}
-
-bool chunk_less(const glm::ivec3& a, const glm::ivec3& b) {
-  if (a.z != b.z) return a.z < b.z;
-  if (a.y != b.y) return a.y < b.y;
-  return a.x < b.x;
 }
 
 std::string chunk_text(const glm::ivec3& c) {
@@ -101,7 +95,7 @@ std::vector<glm::ivec3> chunks_to_visit(const std::vector<PreparedEdit>& edits, 
         for (int x = lo.x; x < hi.x; ++x) out.emplace_back(x, y, z);
   }
   if (all_of_world) world.for_each_chunk([&](const glm::ivec3& c, ChunkKind, const Chunk*) { out.push_back(c); });
-  std::sort(out.begin(), out.end(), chunk_less);
+  std::sort(out.begin(), out.end(), chunk_order_less);
   out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }

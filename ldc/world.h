@@ -340,6 +340,14 @@ struct DirtyChunk {
   glm::ivec3 node_hi{0};  // exclusive
 };
 
+// The one order of chunks across the library: by z, then y, then x. Dirty
+// lists, chunk meshes and the C API's lists are sorted by it.
+inline bool chunk_order_less(const glm::ivec3& a, const glm::ivec3& b) {
+  if (a.z != b.z) return a.z < b.z;
+  if (a.y != b.y) return a.y < b.y;
+  return a.x < b.x;
+}
+
 // Decodes a packed point of the ray segment starting at global depth `segment_start`.
 SurfacePoint decode_point(const PackedPoint& p, int chunk_size, int segment_start);
 

@@ -2,6 +2,7 @@
 // bookkeeping (versions, dirty chunks, undo) and a long random-edit property test.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <map>
@@ -478,50 +479,6 @@ TEST(Editor, ErrorsLeaveTheWorldAsItWas) {
   EXPECT_TRUE(ed.take_dirty().empty());
 }
 
-// Chunk meshes equal: the same chunks, own vertices (in order), vertex data
-// per cell, and triangles by their cells (the order of copies and triangles may differ).
-::testing::AssertionResult same_meshes(const ChunkedMesh& a, const ChunkedMesh& b) {
-  if (a.chunks().size() != b.chunks().size()) {
-    return ::testing::AssertionFailure() << a.chunks().size() << " vs " << b.chunks().size() << " chunk meshes";
-  }
-  using Key = std::array<int, 10>;
-  auto triangles = [](const ChunkMesh& m) {
-    std::vector<Key> out;
-    for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
-      glm::ivec3 c[3] = {m.vertex_cell[m.mesh.triangles[t].x], m.vertex_cell[m.mesh.triangles[t].y],
-                         m.vertex_cell[m.mesh.triangles[t].z]};
-      int first = 0;  // rotate the smallest cell first: same triangle, same key
-      for (int j = 1; j < 3; ++j) {
-        if (std::tie(c[j].z, c[j].y, c[j].x) < std::tie(c[first].z, c[first].y, c[first].x)) first = j;
-      }
-      Key k;
-      for (int j = 0; j < 3; ++j)
-        for (int d = 0; d < 3; ++d) k[size_t(j * 3 + d)] = c[(first + j) % 3][d];
-      k[9] = m.mesh.triangle_material[t];
-      out.push_back(k);
-    }
-    std::sort(out.begin(), out.end());
-    return out;
-  };
-  auto vertices = [](const ChunkMesh& m) {
-    std::map<std::array<int, 3>, std::tuple<glm::dvec3, glm::vec3, uint16_t>> out;
-    for (size_t v = 0; v < m.vertex_cell.size(); ++v) {
-      const glm::ivec3& c = m.vertex_cell[v];
-      out[{c.x, c.y, c.z}] = {m.mesh.positions[v], m.mesh.normals[v], m.mesh.vertex_material[v]};
-    }
-    return out;
-  };
-  for (size_t i = 0; i < a.chunks().size(); ++i) {
-    const ChunkMesh &x = a.chunks()[i], &y = b.chunks()[i];
-    bool same_own = x.own_vertices == y.own_vertices &&
-                    std::equal(x.vertex_cell.begin(), x.vertex_cell.begin() + long(x.own_vertices), y.vertex_cell.begin());
-    if (x.chunk != y.chunk || !same_own || vertices(x) != vertices(y) || triangles(x) != triangles(y)) {
-      return ::testing::AssertionFailure() << "chunk mesh " << i << " differs";
-    }
-  }
-  return ::testing::AssertionSuccess();
-}
-
 TEST(Editor, DirtyBoxesRemeshExactlyWhatAFreshBuildWould) {
   WorldEditor ed(ground(8.0));
   ChunkedMesh incremental;
@@ -543,13 +500,96 @@ TEST(Editor, DirtyBoxesRemeshExactlyWhatAFreshBuildWould) {
   size_t chunks = size_t(ed.world().chunk_dims().x) * ed.world().chunk_dims().y * ed.world().chunk_dims().z;
   for (const auto& e : edits) {
     ASSERT_TRUE(ed.apply(e.brush, e.op).ok());
-    Result<size_t> n = incremental.update(ed.world(), ed.take_dirty());
+    Result<MeshUpdate> n = incremental.update(ed.world(), ed.take_dirty());
     ASSERT_TRUE(n.ok()) << n.status().message();
-    EXPECT_LE(n.value(), chunks / 4);
+    EXPECT_LE(n->chunks_remeshed, chunks / 4);
     ChunkedMesh fresh;
     ASSERT_TRUE(fresh.build(ed.world()).ok());
-    EXPECT_TRUE(same_meshes(incremental, fresh)) << edit_op_name(e.op);
+    EXPECT_TRUE(test::same_chunk_meshes(incremental, fresh)) << edit_op_name(e.op);
   }
+}
+
+// The chunks whose mesh content differs between two sets of chunk meshes
+// (present in one only, or with other vertices or triangles).
+std::vector<glm::ivec3> differing_chunks(const std::vector<ChunkMesh>& before, const std::vector<ChunkMesh>& after) {
+  auto same = [](const ChunkMesh& x, const ChunkMesh& y) {
+    return x.own_vertices == y.own_vertices && x.vertex_cell == y.vertex_cell &&
+           x.mesh.positions == y.mesh.positions && x.mesh.triangles == y.mesh.triangles &&
+           x.mesh.triangle_material == y.mesh.triangle_material && x.mesh.vertex_material == y.mesh.vertex_material;
+  };
+  std::map<std::tuple<int, int, int>, std::pair<const ChunkMesh*, const ChunkMesh*>> all;
+  for (const ChunkMesh& m : before) all[{m.chunk.z, m.chunk.y, m.chunk.x}].first = &m;
+  for (const ChunkMesh& m : after) all[{m.chunk.z, m.chunk.y, m.chunk.x}].second = &m;
+  std::vector<glm::ivec3> out;
+  for (const auto& [key, pair] : all) {
+    const auto [b, a] = pair;
+    if (!b || !a || !same(*b, *a)) out.push_back(b ? b->chunk : a->chunk);
+  }
+  return out;
+}
+
+TEST(ChunkedMeshUpdate, ReportsExactlyTheChunkMeshesWhoseContentChanged) {
+  WorldEditor ed(ground(8.0));
+  ChunkedMesh meshes;
+  ASSERT_TRUE(meshes.build(ed.world()).ok());
+  const uint64_t built = meshes.version();
+  EXPECT_GT(built, 0u);
+  for (const ChunkMesh& m : meshes.chunks()) EXPECT_EQ(m.version, built);
+  const std::vector<WorldEditor::Edit> edits = {
+      {Brush::sphere({0.0, 0.0, 1.0}, 0.7), EditOp::kSubtract},
+      {Brush::sphere({-1.7, -1.7, 1.0}, 0.5, 2), EditOp::kPaint},
+      {Brush::box({1.5, 1.55, 1.2}, glm::dvec3(0.4), 3), EditOp::kAdd},
+  };
+  for (const auto& e : edits) {
+    const std::vector<ChunkMesh> before = meshes.chunks();
+    ASSERT_TRUE(ed.apply(e.brush, e.op).ok());
+    const std::vector<DirtyChunk> dirty = ed.take_dirty();
+    const std::vector<glm::ivec3> may_change = chunks_a_remesh_may_change(dirty, meshes.config(), 16);
+    Result<MeshUpdate> u = meshes.update(ed.world(), dirty);
+    ASSERT_TRUE(u.ok()) << u.status().message();
+    std::vector<glm::ivec3> reported;
+    for (const ChunkMeshChange& c : u->changes) {
+      reported.push_back(c.chunk);
+      EXPECT_FALSE(c.removed());  // these edits leave surface in every chunk they touch
+      EXPECT_EQ(c.version, meshes.version());
+      EXPECT_TRUE(std::binary_search(may_change.begin(), may_change.end(), c.chunk, chunk_order_less));
+    }
+    EXPECT_EQ(reported, differing_chunks(before, meshes.chunks())) << edit_op_name(e.op);
+    EXPECT_FALSE(reported.empty());
+    for (const ChunkMesh& m : meshes.chunks()) {
+      const bool was_reported = std::find(reported.begin(), reported.end(), m.chunk) != reported.end();
+      if (!was_reported) EXPECT_LT(m.version, meshes.version());
+    }
+  }
+}
+
+TEST(ChunkedMeshUpdate, ChunksLeftWithoutSurfaceAreReportedRemoved) {
+  WorldEditor ed(ground(8.0));
+  ChunkedMesh meshes;
+  ASSERT_TRUE(meshes.build(ed.world()).ok());
+  const size_t chunks_before = meshes.chunks().size();
+  // Dig the whole slab out: every chunk mesh goes.
+  ASSERT_TRUE(ed.apply(Brush::box({0.0, 0.0, 0.0}, {9.0, 9.0, 2.5}), EditOp::kSubtract).ok());
+  Result<MeshUpdate> u = meshes.update(ed.world(), ed.take_dirty());
+  ASSERT_TRUE(u.ok()) << u.status().message();
+  EXPECT_TRUE(meshes.chunks().empty());
+  size_t removed = 0;
+  for (const ChunkMeshChange& c : u->changes) removed += c.removed();
+  EXPECT_EQ(removed, chunks_before);
+  EXPECT_EQ(removed, u->changes.size());
+}
+
+TEST(ChunkedMeshUpdate, AnEditThatChangesNoSurfaceReportsNothing) {
+  WorldEditor ed(ground(8.0));
+  ChunkedMesh meshes;
+  ASSERT_TRUE(meshes.build(ed.world()).ok());
+  const uint64_t version = meshes.version();
+  // Adding solid inside the solid slab changes the rays' nothing.
+  ASSERT_TRUE(ed.apply(Brush::sphere({0.0, 0.0, 0.0}, 0.3, 1), EditOp::kAdd).ok());
+  Result<MeshUpdate> u = meshes.update(ed.world(), ed.take_dirty());
+  ASSERT_TRUE(u.ok());
+  EXPECT_TRUE(u->changes.empty());
+  EXPECT_EQ(meshes.version(), version);
 }
 
 // Random brushes of every shape, size and op, many placed on lattice nodes or

@@ -1,7 +1,11 @@
 #include "test_util.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
+#include <tuple>
+#include <vector>
 
 namespace ldc::test {
 
@@ -78,6 +82,50 @@ void append_mesh(TriangleMesh& a, const TriangleMesh& b) {
   ValidationReport r = validate(world);
   if (r.ok) return ::testing::AssertionSuccess();
   return ::testing::AssertionFailure() << r.summary();
+}
+
+// Chunk meshes equal: the same chunks, own vertices (in order), vertex data
+// per cell, and triangles by their cells (the order of copies and triangles may differ).
+::testing::AssertionResult same_chunk_meshes(const ChunkedMesh& a, const ChunkedMesh& b) {
+  if (a.chunks().size() != b.chunks().size()) {
+    return ::testing::AssertionFailure() << a.chunks().size() << " vs " << b.chunks().size() << " chunk meshes";
+  }
+  using Key = std::array<int, 10>;
+  auto triangles = [](const ChunkMesh& m) {
+    std::vector<Key> out;
+    for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
+      glm::ivec3 c[3] = {m.vertex_cell[m.mesh.triangles[t].x], m.vertex_cell[m.mesh.triangles[t].y],
+                         m.vertex_cell[m.mesh.triangles[t].z]};
+      int first = 0;  // rotate the smallest cell first: same triangle, same key
+      for (int j = 1; j < 3; ++j) {
+        if (std::tie(c[j].z, c[j].y, c[j].x) < std::tie(c[first].z, c[first].y, c[first].x)) first = j;
+      }
+      Key k;
+      for (int j = 0; j < 3; ++j)
+        for (int d = 0; d < 3; ++d) k[size_t(j * 3 + d)] = c[(first + j) % 3][d];
+      k[9] = m.mesh.triangle_material[t];
+      out.push_back(k);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  auto vertices = [](const ChunkMesh& m) {
+    std::map<std::array<int, 3>, std::tuple<glm::dvec3, glm::vec3, uint16_t>> out;
+    for (size_t v = 0; v < m.vertex_cell.size(); ++v) {
+      const glm::ivec3& c = m.vertex_cell[v];
+      out[{c.x, c.y, c.z}] = {m.mesh.positions[v], m.mesh.normals[v], m.mesh.vertex_material[v]};
+    }
+    return out;
+  };
+  for (size_t i = 0; i < a.chunks().size(); ++i) {
+    const ChunkMesh &x = a.chunks()[i], &y = b.chunks()[i];
+    bool same_own = x.own_vertices == y.own_vertices &&
+                    std::equal(x.vertex_cell.begin(), x.vertex_cell.begin() + long(x.own_vertices), y.vertex_cell.begin());
+    if (x.chunk != y.chunk || !same_own || vertices(x) != vertices(y) || triangles(x) != triangles(y)) {
+      return ::testing::AssertionFailure() << "chunk mesh " << i << " differs";
+    }
+  }
+  return ::testing::AssertionSuccess();
 }
 
 }  // namespace ldc::test

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "contour/contour.h"
 #include "ldc/mesh.h"
 #include "ldc/world.h"
 
@@ -28,5 +29,10 @@ void append_mesh(TriangleMesh& a, const TriangleMesh& b);
 
 // Fails the test with the report's messages unless validate() passes.
 ::testing::AssertionResult is_valid(const World& world);
+
+// Chunk meshes equal: the same chunks, own vertices (in order), vertex data
+// per cell, and triangles by their cells (the order of copies and triangles
+// may differ: an incremental update and a fresh build agree up to that).
+::testing::AssertionResult same_chunk_meshes(const ChunkedMesh& a, const ChunkedMesh& b);
 
 }  // namespace ldc::test
