@@ -92,6 +92,15 @@ LDC_C_API int ldc_version(void);
 /* The .ldc file format version this library reads and writes. */
 LDC_C_API int ldc_format_version(void);
 
+/* Threads. The library's parallel work runs on TBB, one thread per core by
+ * default. This caps it at `max_threads` for the whole process (TBB's
+ * global_control: it also caps other TBB users in the process); 0 lifts the
+ * cap. An engine that must share cores with its own job system calls this
+ * once at start-up. [0 .. 4096] */
+LDC_C_API ldc_status ldc_set_max_threads(int32_t max_threads);
+/* The number of threads the library's parallel work may use now. */
+LDC_C_API int32_t ldc_max_threads(void);
+
 /* ------------------------------------------------------------------------ */
 /* Worlds                                                                    */
 

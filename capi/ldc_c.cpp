@@ -3,24 +3,25 @@
 // (std::bad_alloc, anything else) into a status, and records the message of
 // a failure in a thread-local string.
 //
-// A world handle owns a WorldEditor and what the C API keeps beside it: the
+// A world handle owns a LiveWorld (live/live.h): the world, its editor, the
 // query cache, the chunk meshes, the navigation mesh and the cascades made
-// from it. After every edit the editor's dirty chunks are fanned out to each
-// of them (pending lists applied lazily before their next use) and to the
-// list ldc_world_take_dirty hands to the caller.
+// from it. The LiveWorld fans every edit's dirty chunks out to them and to
+// the list ldc_world_take_dirty hands to the caller; the C API brings each
+// consumer up to date lazily, before its next use.
 #include "capi/ldc.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <exception>
-#include <map>
 #include <memory>
+#include <mutex>
 #include <new>
 #include <optional>
 #include <string>
-#include <tuple>
 #include <vector>
+
+#include <tbb/global_control.h>
 
 #include "contour/contour.h"
 #include "csg/csg.h"
@@ -29,6 +30,7 @@
 #include "ldc/terrain.h"
 #include "ldc/version.h"
 #include "ldc/world.h"
+#include "live/live.h"
 #include "nav/nav.h"
 #include "voxelize/voxelize.h"
 
@@ -88,87 +90,29 @@ void put(const glm::dvec3& v, double out[3]) { out[0] = v.x, out[1] = v.y, out[2
 void put(const glm::ivec3& v, int32_t out[3]) { out[0] = v.x, out[1] = v.y, out[2] = v.z; }
 void put(const glm::vec3& v, float out[3]) { out[0] = v.x, out[1] = v.y, out[2] = v.z; }
 
-// Sorts chunks by (z, y, x), the order take_dirty promises.
-using ChunkKey = std::tuple<int, int, int>;
-ChunkKey key_of(const glm::ivec3& c) { return {c.z, c.y, c.x}; }
-
 }  // namespace
 
 struct ldc_cascades {
   ldc_world* world = nullptr;  // nulled when the world is destroyed first
-  ldc::Cascades cascades;
-  std::vector<ldc::DirtyChunk> pending;
+  ldc::CascadesId id = 0;      // the world's cascades while `world` is set
+  std::unique_ptr<ldc::Cascades> orphan;  // handed over when the world was destroyed
   ldc::PackedGBuffer scratch;
+  ldc::Cascades& get() const;
 };
 
 struct ldc_world {
-  explicit ldc_world(ldc::World w) : editor(std::move(w)) {}
+  explicit ldc_world(ldc::LiveWorld l) : live(std::move(l)) {}
 
-  ldc::WorldEditor editor;
-  std::unique_ptr<ldc::Queries> queries;  // on first ray cast
-  bool queries_stale = false;             // edits since the last refresh()
-
-  std::map<ChunkKey, ldc_dirty_chunk> user_dirty;
-
-  ldc::ContourConfig contour_config;
-  ldc::ChunkedMesh mesh{contour_config};
-  bool mesh_built = false;
-  std::vector<ldc::DirtyChunk> mesh_pending;
-
-  ldc::NavConfig nav_config;
-  int max_nodes = 2048;
+  ldc::LiveWorld live;
+  ldc::NavConfig nav_config;  // the agent of the nav mesh built at the next path query
   glm::dvec3 search_half_extents{2.0, 2.0, 4.0};
-  std::optional<ldc::NavMesh> nav;
-  std::optional<ldc::NavQuery> query;  // on `nav`, kept between paths (its search arrays are reused)
-  std::vector<ldc::DirtyChunk> nav_pending;
-
   std::vector<ldc_cascades*> cascades;
 
-  const ldc::World& world() const { return editor.world(); }
-  void fan_out(const std::vector<ldc::DirtyChunk>& dirty);
-  void mark_mesh_neighbours(const ldc::DirtyChunk& d);
+  const ldc::World& world() const { return live.world(); }
 };
 
-// Chunks whose mesh can change with d: those holding a cell within the
-// re-mesh margin (ChunkedMesh::update grows each box by relax_iterations + 1
-// cells) plus one cell for the neighbour vertices a chunk mesh copies.
-void ldc_world::mark_mesh_neighbours(const ldc::DirtyChunk& d) {
-  const int margin = contour_config.relax_iterations + 3;
-  const ldc::World& w = world();
-  const glm::ivec3 lo = w.chunk_of_node(d.node_lo - glm::ivec3(margin));
-  const glm::ivec3 hi = w.chunk_of_node(d.node_hi - glm::ivec3(1) + glm::ivec3(margin));
-  for (int z = lo.z; z <= hi.z; ++z)
-    for (int y = lo.y; y <= hi.y; ++y)
-      for (int x = lo.x; x <= hi.x; ++x) {
-        const glm::ivec3 c{x, y, z};
-        if (!w.contains_chunk(c)) continue;
-        auto [it, added] = user_dirty.try_emplace(key_of(c), ldc_dirty_chunk{});
-        if (added) put(c, it->second.chunk);
-        it->second.flags |= LDC_DIRTY_MESH;
-      }
-}
-
-void ldc_world::fan_out(const std::vector<ldc::DirtyChunk>& dirty) {
-  for (const ldc::DirtyChunk& d : dirty) {
-    auto [it, added] = user_dirty.try_emplace(key_of(d.chunk), ldc_dirty_chunk{});
-    ldc_dirty_chunk& u = it->second;
-    if (added) put(d.chunk, u.chunk);
-    if (u.flags & LDC_DIRTY_DATA) {
-      put(glm::min(ivec3(u.node_lo), d.node_lo), u.node_lo);
-      put(glm::max(ivec3(u.node_hi), d.node_hi), u.node_hi);
-    } else {
-      put(d.node_lo, u.node_lo);
-      put(d.node_hi, u.node_hi);
-    }
-    u.flags |= LDC_DIRTY_DATA;
-    u.version = d.version;
-    mark_mesh_neighbours(d);
-  }
-  // Only what is built needs the list: a first build reads the world as it is.
-  if (mesh_built) mesh_pending.insert(mesh_pending.end(), dirty.begin(), dirty.end());
-  if (nav) nav_pending.insert(nav_pending.end(), dirty.begin(), dirty.end());
-  for (ldc_cascades* c : cascades) c->pending.insert(c->pending.end(), dirty.begin(), dirty.end());
-  queries_stale = true;
+ldc::Cascades& ldc_cascades::get() const {
+  return world ? *world->live.cascades(id) : *orphan;
 }
 
 // ---------------------------------------------------------------------------
@@ -194,6 +138,31 @@ const char* ldc_last_error(void) { return g_last_error.c_str(); }
 const char* ldc_version_string(void) { return LDC_VERSION_STRING; }
 int ldc_version(void) { return LDC_VERSION; }
 int ldc_format_version(void) { return LDC_FORMAT_VERSION; }
+
+// The cap ldc_set_max_threads set (null: none). TBB's own limit is process-wide
+// whatever the holder; one holder keeps it from stacking up.
+static std::unique_ptr<tbb::global_control> g_thread_cap;
+static std::mutex g_thread_cap_mutex;
+
+ldc_status ldc_set_max_threads(int32_t max_threads) {
+  return guarded("ldc_set_max_threads", [&] {
+    if (max_threads < 0 || max_threads > 4096) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_set_max_threads: max_threads " + std::to_string(max_threads) +
+                                            " must be in 0 .. 4096 (0 lifts the cap)");
+    }
+    std::lock_guard<std::mutex> lock(g_thread_cap_mutex);
+    g_thread_cap.reset();
+    if (max_threads > 0) {
+      g_thread_cap = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
+                                                           size_t(max_threads));
+    }
+    return LDC_OK;
+  });
+}
+
+int32_t ldc_max_threads(void) {
+  return int32_t(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+}
 
 // ---------------------------------------------------------------------------
 // Worlds
@@ -225,7 +194,9 @@ void ldc_terrain_config_default(ldc_terrain_config* config) {
 
 static ldc_status adopt(ldc::Result<ldc::World> world, ldc_world** out) {
   if (!world.ok()) return from_status(world.status());
-  *out = new ldc_world(std::move(world).value());
+  ldc::Result<ldc::LiveWorld> live = ldc::LiveWorld::create(std::move(world).value());
+  if (!live.ok()) return from_status(live.status());
+  *out = new ldc_world(std::move(live).value());
   return LDC_OK;
 }
 
@@ -283,7 +254,10 @@ ldc_status ldc_world_save(const ldc_world* world, const char* path) {
 
 void ldc_world_destroy(ldc_world* world) {
   if (!world) return;
-  for (ldc_cascades* c : world->cascades) c->world = nullptr;
+  for (ldc_cascades* c : world->cascades) {
+    c->orphan = world->live.release_cascades(c->id);
+    c->world = nullptr;
+  }
   delete world;
 }
 
@@ -307,7 +281,7 @@ ldc_status ldc_world_get_info(const ldc_world* world, ldc_world_info* out) {
     info.chunks_mixed = s.chunks_mixed;
     info.points = s.points;
     info.memory_bytes = s.memory_bytes;
-    info.edit_version = world->editor.version();
+    info.edit_version = world->live.version();
     *out = info;
     return LDC_OK;
   });
@@ -353,9 +327,8 @@ ldc_status ldc_world_edit(ldc_world* world, const ldc_brush* brush, ldc_edit_op 
     if (!b.ok()) return from_status(b.status());
     ldc::Result<ldc::EditOp> o = to_op(raw_enum(op));
     if (!o.ok()) return from_status(o.status());
-    ldc::Result<ldc::EditReceipt> receipt = world->editor.apply(b.value(), o.value());
+    ldc::Result<ldc::EditReceipt> receipt = world->live.apply(b.value(), o.value());
     if (!receipt.ok()) return from_status(receipt.status());
-    world->fan_out(world->editor.take_dirty());
     if (out) {
       out->version = receipt->version;
       out->chunks_changed = receipt->changed_chunks.size();
@@ -368,7 +341,7 @@ ldc_status ldc_world_take_dirty(ldc_world* world, ldc_dirty_chunk* out, size_t c
   return guarded("ldc_world_take_dirty", [&] {
     if (!world) return null_argument("ldc_world_take_dirty", "world");
     if (!count) return null_argument("ldc_world_take_dirty", "count");
-    const size_t n = world->user_dirty.size();
+    const size_t n = world->live.pending_changes();
     *count = n;
     if (!out) return LDC_OK;
     if (capacity < n) {
@@ -376,8 +349,17 @@ ldc_status ldc_world_take_dirty(ldc_world* world, ldc_dirty_chunk* out, size_t c
                                             " dirty chunks, capacity " + std::to_string(capacity));
     }
     size_t i = 0;
-    for (const auto& [key, d] : world->user_dirty) out[i++] = d;
-    world->user_dirty.clear();
+    for (const ldc::ChunkChange& c : world->live.take_changes()) {
+      ldc_dirty_chunk d{};
+      put(c.chunk, d.chunk);
+      d.flags = (c.data ? LDC_DIRTY_DATA : 0u) | (c.mesh ? LDC_DIRTY_MESH : 0u);
+      d.version = c.version;
+      if (c.data) {
+        put(c.node_lo, d.node_lo);
+        put(c.node_hi, d.node_hi);
+      }
+      out[i++] = d;
+    }
     return LDC_OK;
   });
 }
@@ -385,25 +367,15 @@ ldc_status ldc_world_take_dirty(ldc_world* world, ldc_dirty_chunk* out, size_t c
 // ---------------------------------------------------------------------------
 // Meshing
 
-static ldc::Status sync_mesh(ldc_world* world) {
-  if (!world->mesh_built) {
-    world->mesh = ldc::ChunkedMesh(world->contour_config);
-    ldc::Status s = world->mesh.build(world->world());
+// The chunk meshes, built on first use and brought up to date with the edits since.
+static ldc::Result<const ldc::ChunkedMesh*> synced_meshes(ldc_world* world) {
+  if (!world->live.meshes()) {
+    ldc::Status s = world->live.enable_meshes(world->live.config().contour);
     if (!s.ok()) return s;
-    world->mesh_built = true;
-  } else if (!world->mesh_pending.empty()) {
-    ldc::Result<size_t> r = world->mesh.update(world->world(), world->mesh_pending);
-    if (!r.ok()) return r.status();
   }
-  world->mesh_pending.clear();
-  return {};
-}
-
-static const ldc::ChunkMesh* find_chunk_mesh(const ldc::ChunkedMesh& mesh, const glm::ivec3& chunk) {
-  const std::vector<ldc::ChunkMesh>& all = mesh.chunks();
-  auto it = std::lower_bound(all.begin(), all.end(), key_of(chunk),
-                             [](const ldc::ChunkMesh& m, const ChunkKey& k) { return key_of(m.chunk) < k; });
-  return it != all.end() && it->chunk == chunk ? &*it : nullptr;
+  ldc::Status s = world->live.update_meshes();
+  if (!s.ok()) return s;
+  return world->live.meshes();
 }
 
 static void copy_mesh(const ldc::ContourMesh& m, ldc_mesh_buffers* b) {
@@ -423,8 +395,9 @@ ldc_status ldc_world_mesh_chunk(ldc_world* world, const int32_t chunk[3], ldc_me
     if (!world) return null_argument("ldc_world_mesh_chunk", "world");
     if (!chunk) return null_argument("ldc_world_mesh_chunk", "chunk");
     if (!buffers) return null_argument("ldc_world_mesh_chunk", "buffers");
-    if (ldc_status s = from_status(sync_mesh(world)); s != LDC_OK) return s;
-    const ldc::ChunkMesh* cm = find_chunk_mesh(world->mesh, ivec3(chunk));
+    ldc::Result<const ldc::ChunkedMesh*> meshes = synced_meshes(world);
+    if (!meshes.ok()) return from_status(meshes.status());
+    const ldc::ChunkMesh* cm = (*meshes)->find(ivec3(chunk));
     static const ldc::ContourMesh kEmpty;
     const ldc::ContourMesh& m = cm ? cm->mesh : kEmpty;
     buffers->vertex_count = m.vertex_count();
@@ -456,12 +429,7 @@ ldc_status ldc_world_ray_cast(ldc_world* world, const ldc_ray* rays, size_t coun
     if (count == 0) return LDC_OK;
     if (!rays) return null_argument("ldc_world_ray_cast", "rays");
     if (!hits) return null_argument("ldc_world_ray_cast", "hits");
-    if (!world->queries) {
-      world->queries = std::make_unique<ldc::Queries>(world->world());
-    } else if (world->queries_stale) {
-      world->queries->refresh();
-    }
-    world->queries_stale = false;
+    world->live.update_queries();
     std::vector<ldc::Ray> in(count);
     for (size_t i = 0; i < count; ++i) {
       in[i].origin = vec3(rays[i].origin);
@@ -469,7 +437,7 @@ ldc_status ldc_world_ray_cast(ldc_world* world, const ldc_ray* rays, size_t coun
       in[i].max_distance = rays[i].max_distance;
     }
     std::vector<ldc::RayHit> out(count);
-    if (ldc_status s = from_status(world->queries->ray_cast(in, out)); s != LDC_OK) return s;
+    if (ldc_status s = from_status(world->live.queries().ray_cast(in, out)); s != LDC_OK) return s;
     for (size_t i = 0; i < count; ++i) {
       ldc_ray_hit h{};
       h.hit = out[i].hit ? 1 : 0;
@@ -520,28 +488,21 @@ ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* conf
       return fail(LDC_INVALID_ARGUMENT,
                   "ldc_world_set_nav_config: search_half_extents must be finite and > 0 on every axis");
     }
+    world->live.disable_nav();  // rebuilt with these at the next path query
+    if (ldc_status s = from_status(world->live.set_max_path_nodes(config->max_nodes)); s != LDC_OK) return s;
     world->nav_config = c;
-    world->max_nodes = config->max_nodes;
     world->search_half_extents = half;
-    world->query.reset();
-    world->nav.reset();
-    world->nav_pending.clear();
     return LDC_OK;
   });
 }
 
-static ldc::Status sync_nav(ldc_world* world) {
-  if (!world->nav) {
-    ldc::Result<ldc::NavMesh> nav = ldc::NavMesh::build(world->world(), world->nav_config);
-    if (!nav.ok()) return nav.status();
-    world->nav.emplace(std::move(nav).value());
-    world->query.emplace(*world->nav, world->max_nodes);
-  } else if (!world->nav_pending.empty()) {
-    ldc::Result<ldc::NavUpdateStats> r = world->nav->update(world->world(), world->nav_pending);
-    if (!r.ok()) return r.status();
+// The path query on a nav mesh built on first use and brought up to date with the edits since.
+static ldc::Result<ldc::NavQuery*> synced_path_query(ldc_world* world) {
+  if (!world->live.nav()) {
+    ldc::Status s = world->live.enable_nav(world->nav_config);
+    if (!s.ok()) return s;
   }
-  world->nav_pending.clear();
-  return {};
+  return world->live.path_query();
 }
 
 ldc_status ldc_world_find_path(ldc_world* world, const double from[3], const double to[3], double* corners,
@@ -550,10 +511,11 @@ ldc_status ldc_world_find_path(ldc_world* world, const double from[3], const dou
     if (!world) return null_argument("ldc_world_find_path", "world");
     if (!from || !to) return null_argument("ldc_world_find_path", from ? "to" : "from");
     if (!info) return null_argument("ldc_world_find_path", "info");
-    if (ldc_status s = from_status(sync_nav(world)); s != LDC_OK) return s;
+    ldc::Result<ldc::NavQuery*> query = synced_path_query(world);
+    if (!query.ok()) return from_status(query.status());
     ldc::PathQueryOptions options;
     options.search_half_extents = world->search_half_extents;
-    ldc::Result<ldc::NavPath> path = world->query->find_path(vec3(from), vec3(to), options);
+    ldc::Result<ldc::NavPath> path = (*query)->find_path(vec3(from), vec3(to), options);
     if (!path.ok()) {
       const bool no_floor = path.status().message().find("no walkable floor") != std::string::npos;
       return fail(no_floor ? LDC_NOT_FOUND : static_cast<ldc_status>(path.status().code()),
@@ -598,9 +560,11 @@ ldc_status ldc_cascades_create(ldc_world* world, const ldc_cascade_config* confi
     c.levels = config->levels;
     c.resolution = config->resolution;
     c.voxel_size = config->voxel_size;
-    ldc::Result<ldc::Cascades> cascades = ldc::Cascades::create(world->world().lattice(), c);
-    if (!cascades.ok()) return from_status(cascades.status());
-    auto handle = std::make_unique<ldc_cascades>(ldc_cascades{world, std::move(cascades).value(), {}, {}});
+    ldc::Result<ldc::CascadesId> id = world->live.add_cascades(c);
+    if (!id.ok()) return from_status(id.status());
+    auto handle = std::make_unique<ldc_cascades>();
+    handle->world = world;
+    handle->id = id.value();
     world->cascades.push_back(handle.get());
     *out = handle.release();
     return LDC_OK;
@@ -611,6 +575,7 @@ void ldc_cascades_destroy(ldc_cascades* cascades) {
   if (!cascades) return;
   if (ldc_world* w = cascades->world) {
     std::erase(w->cascades, cascades);
+    (void)w->live.release_cascades(cascades->id);
   }
   delete cascades;
 }
@@ -624,14 +589,10 @@ ldc_status ldc_cascades_update_level(ldc_cascades* cascades, int32_t level, cons
       return fail(LDC_INVALID_ARGUMENT, "ldc_cascades_update_level: the world these cascades were made "
                                         "from has been destroyed");
     }
-    ldc::Cascades& c = cascades->cascades;
+    ldc::Cascades& c = cascades->get();
     if (level < 0 || level >= c.levels()) {
       return fail(LDC_INVALID_ARGUMENT, "ldc_cascades_update_level: level " + std::to_string(level) +
                                             " must be in 0 .. " + std::to_string(c.levels() - 1));
-    }
-    if (!cascades->pending.empty()) {
-      c.invalidate(cascades->pending);
-      cascades->pending.clear();
     }
     ldc::Result<ldc::CascadeUpdate> u = c.update_level(cascades->world->world(), level, vec3(camera));
     if (!u.ok()) return from_status(u.status());
@@ -654,7 +615,7 @@ ldc_status ldc_cascades_read_level(const ldc_cascades* cascades, int32_t level, 
   return guarded("ldc_cascades_read_level", [&] {
     if (!cascades) return null_argument("ldc_cascades_read_level", "cascades");
     if (!buffers) return null_argument("ldc_cascades_read_level", "buffers");
-    const ldc::Cascades& c = cascades->cascades;
+    const ldc::Cascades& c = cascades->get();
     if (level < 0 || level >= c.levels()) {
       return fail(LDC_INVALID_ARGUMENT, "ldc_cascades_read_level: level " + std::to_string(level) +
                                             " must be in 0 .. " + std::to_string(c.levels() - 1));

@@ -1,9 +1,9 @@
 # Install rules and the CMake package: `cmake --install build --prefix P` puts
-#   P/include/ldc/{ldc,contour,csg,nav,voxelize,capi}/*.h   public headers only
+#   P/include/ldc/{ldc,contour,csg,nav,voxelize,live,capi}/*.h   public headers only
 #   P/lib/libldc_*.a, P/lib/libldc_c.so*                    the libraries
 #   P/lib/cmake/ldc/ldcConfig.cmake, ldcConfigVersion.cmake, ldcTargets*.cmake
 # and `find_package(ldc 0.2)` then gives ldc::core, ldc::contour, ldc::csg,
-# ldc::nav, ldc::voxelize, ldc::voxelize_vdb (when it was built), ldc::c (the
+# ldc::nav, ldc::voxelize, ldc::live, ldc::voxelize_vdb (when it was built), ldc::c (the
 # C API) and ldc::gi (only when gi_bridge/ was built, with Vulkan).
 #
 # Headers keep the paths the sources use ("ldc/world.h", "csg/csg.h"): the
@@ -20,12 +20,13 @@ set(LDC_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/ldc CACHE STRING
 set(ldc_header_dir ${CMAKE_INSTALL_INCLUDEDIR}/ldc)
 
 # Module target -> exported name (ldc::<name>) and its public headers.
-set(ldc_export_targets ldc_core ldc_contour ldc_csg ldc_nav ldc_voxelize)
+set(ldc_export_targets ldc_core ldc_contour ldc_csg ldc_nav ldc_voxelize ldc_live)
 set_target_properties(ldc_core PROPERTIES EXPORT_NAME core)
 set_target_properties(ldc_contour PROPERTIES EXPORT_NAME contour)
 set_target_properties(ldc_csg PROPERTIES EXPORT_NAME csg)
 set_target_properties(ldc_nav PROPERTIES EXPORT_NAME nav)
 set_target_properties(ldc_voxelize PROPERTIES EXPORT_NAME voxelize)
+set_target_properties(ldc_live PROPERTIES EXPORT_NAME live)
 install(FILES ldc/build.h ldc/context.h ldc/io.h ldc/mesh.h ldc/query.h ldc/status.h
               ldc/terrain.h ldc/version.h ldc/world.h
         DESTINATION ${ldc_header_dir}/ldc COMPONENT dev)
@@ -34,6 +35,7 @@ install(FILES contour/contour.h contour/export.h contour/openmesh.h
 install(FILES csg/csg.h DESTINATION ${ldc_header_dir}/csg COMPONENT dev)
 install(FILES nav/nav.h DESTINATION ${ldc_header_dir}/nav COMPONENT dev)
 install(FILES voxelize/voxelize.h DESTINATION ${ldc_header_dir}/voxelize COMPONENT dev)
+install(FILES live/live.h DESTINATION ${ldc_header_dir}/live COMPONENT dev)
 set(LDC_PACKAGE_HAS_VDB OFF)
 if(TARGET ldc_voxelize_vdb)
   set(LDC_PACKAGE_HAS_VDB ON)

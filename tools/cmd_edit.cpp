@@ -7,6 +7,7 @@
 #include "contour/export.h"
 #include "edit_script.h"
 #include "ldc/io.h"
+#include "live/live.h"
 #include "mesh_output.h"
 
 namespace ldc::tool {
@@ -21,20 +22,17 @@ struct EditArgs {
   std::string mesh;  // --mesh: contour before the edits, re-mesh after each, write here
 };
 
-// The mesh kept up to date edit by edit, as a game would: built once, then
-// only what each edit dirtied is re-meshed (ChunkedMesh::update).
-struct LiveMesh {
-  std::unique_ptr<ChunkedMesh> meshes;  // null without --mesh
-  Status update(WorldEditor& editor, nlohmann::json& entry) {
-    if (!meshes) return {};
-    ScopedTimer t(nullptr, "");
-    Result<size_t> spliced = meshes->update(editor.world(), editor.take_dirty());
-    if (!spliced.ok()) return spliced.status();
-    entry["remesh_ms"] = 1000.0 * t.seconds();
-    entry["chunk_meshes_updated"] = spliced.value();
-    return {};
-  }
-};
+// With --mesh the live world keeps chunk meshes, as a game would: built
+// once, then only what each edit dirtied is re-meshed.
+Status update_meshes(LiveWorld& live, nlohmann::json& entry) {
+  if (!live.meshes()) return {};
+  Result<LiveUpdate> u = live.update();
+  if (!u.ok()) return u.status();
+  entry["remesh_ms"] = 1000.0 * u->mesh_seconds;
+  entry["chunk_meshes_updated"] = u->chunks_remeshed;
+  entry["chunk_meshes_changed"] = u->meshes.size();
+  return {};
+}
 
 
 nlohmann::json edit_json(size_t index, const ScriptEdit& e) {
@@ -42,11 +40,10 @@ nlohmann::json edit_json(size_t index, const ScriptEdit& e) {
 }
 
 // One apply per edit, so that each edit's chunks and time are its own.
-Status apply_each(WorldEditor& editor, const std::vector<ScriptEdit>& edits, LiveMesh& live, Context* ctx,
-                  nlohmann::json& report) {
+Status apply_each(LiveWorld& live, const std::vector<ScriptEdit>& edits, Context* ctx, nlohmann::json& report) {
   for (size_t i = 0; i < edits.size(); ++i) {
     ScopedTimer t(nullptr, "");
-    Result<EditReceipt> r = editor.apply(edits[i].edit.brush, edits[i].edit.op, ctx);
+    Result<EditReceipt> r = live.apply(edits[i].edit.brush, edits[i].edit.op, ctx);
     if (!r.ok()) {
       return Status(r.status().code(), "edit " + std::to_string(i) + " (" + edit_op_name(edits[i].edit.op) + " " +
                                            edits[i].brush_name + ") failed: " + r.status().message());
@@ -54,7 +51,7 @@ Status apply_each(WorldEditor& editor, const std::vector<ScriptEdit>& edits, Liv
     nlohmann::json e = edit_json(i, edits[i]);
     e["chunks_changed"] = r.value().changed_chunks.size();
     e["ms"] = 1000.0 * t.seconds();
-    Status s = live.update(editor, e);
+    Status s = update_meshes(live, e);
     if (!s.ok()) return s;
     report["edits"].push_back(std::move(e));
   }
@@ -63,16 +60,15 @@ Status apply_each(WorldEditor& editor, const std::vector<ScriptEdit>& edits, Liv
 
 // One apply_batch: one undo step that visits each chunk once, so chunks and
 // time are known for the batch only. The library's errors name the edit index.
-Status apply_as_batch(WorldEditor& editor, const std::vector<ScriptEdit>& edits, LiveMesh& live, Context* ctx,
-                      nlohmann::json& report) {
+Status apply_as_batch(LiveWorld& live, const std::vector<ScriptEdit>& edits, Context* ctx, nlohmann::json& report) {
   std::vector<WorldEditor::Edit> batch;
   for (const ScriptEdit& e : edits) batch.push_back(e.edit);
   ScopedTimer t(nullptr, "");
-  Result<EditReceipt> r = editor.apply_batch(batch, ctx);
+  Result<EditReceipt> r = live.apply_batch(batch, ctx);
   if (!r.ok()) return r.status();
   for (size_t i = 0; i < edits.size(); ++i) report["edits"].push_back(edit_json(i, edits[i]));
   report["batch"] = {{"chunks_changed", r.value().changed_chunks.size()}, {"ms", 1000.0 * t.seconds()}};
-  return live.update(editor, report["batch"]);
+  return update_meshes(live, report["batch"]);
 }
 
 // --validate: an invalid result is an error, and nothing is written.
@@ -123,33 +119,29 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   if (!w.ok()) return fail("edit", w.status());
   nlohmann::json report = {{"input", a.input}, {"script", a.script}, {"output", a.output},
                            {"edits", nlohmann::json::array()}, {"seconds", {{"load", load.seconds()}}}};
-  WorldEditor editor(std::move(w).value());
-  LiveMesh live;
-  if (!a.mesh.empty()) {
-    ScopedTimer t(nullptr, "");
-    live.meshes = std::make_unique<ChunkedMesh>();
-    Status built = live.meshes->build(editor.world(), bar.context());
-    if (!built.ok()) return fail("edit", built);
-    report["seconds"]["contour_before_edits"] = t.seconds();
-  }
+  ScopedTimer contour(nullptr, "");
+  Result<LiveWorld> created = LiveWorld::create(std::move(w).value(), {.meshes = !a.mesh.empty()}, bar.context());
+  if (!created.ok()) return fail("edit", created.status());
+  LiveWorld& live = created.value();
+  if (live.meshes()) report["seconds"]["contour_before_edits"] = contour.seconds();
   ScopedTimer apply(nullptr, "");
-  Status s = a.batch ? apply_as_batch(editor, edits.value(), live, bar.context(), report)
-                     : apply_each(editor, edits.value(), live, bar.context(), report);
+  Status s = a.batch ? apply_as_batch(live, edits.value(), bar.context(), report)
+                     : apply_each(live, edits.value(), bar.context(), report);
   report["seconds"]["edits"] = apply.seconds();
   if (!s.ok()) return fail("edit", s);
-  if (a.validate && !(s = validate_result(editor.world(), report)).ok()) {
+  if (a.validate && !(s = validate_result(live.world(), report)).ok()) {
     fail("edit", s);
     return 2;  // as `ldc build --validate`
   }
   ScopedTimer save(nullptr, "");
-  s = save_world(editor.world(), a.output, {}, bar.context());
+  s = save_world(live.world(), a.output, {}, bar.context());
   report["seconds"]["save"] = save.seconds();
   bar.finish();
   if (!s.ok()) return fail("edit", s);
-  report["version"] = editor.version();
-  if (live.meshes) {
+  report["version"] = live.version();
+  if (live.meshes()) {
     report["world_output"] = a.output;
-    return write_and_report("edit", editor.world(), live.meshes->assemble(), live.meshes->stats(), a.mesh, bar,
+    return write_and_report("edit", live.world(), live.meshes()->assemble(), live.meshes()->stats(), a.mesh, bar,
                             std::move(report), common, [](const nlohmann::json& r) {
                               nlohmann::json edits_only = r;
                               edits_only["output"] = r["world_output"];

@@ -1,16 +1,19 @@
 // A scripted play session on the default landscape: the "does it fit in a
 // frame" proof for engine programmers.
 //
-// Every frame, as a game would:
+// One LiveWorld (live/live.h) owns the world, its chunk meshes, nav mesh
+// and query caches. Every frame, as a game would:
 //   1. edit     the player digs a trench (1.2 m spheres) as it walks west
 //               across the landscape (every fifth frame it builds a pillar
-//               beside the trench instead): one WorldEditor::apply;
-//   2. re-mesh  the chunks the edit dirtied are re-meshed (ChunkedMesh::update);
-//   3. nav      the navigation mesh takes the same dirty chunks (NavMesh::update);
+//               beside the trench instead): one LiveWorld::apply;
+//   2. re-mesh  LiveWorld::update_meshes re-meshes what the edit dirtied and
+//               names the chunk meshes that changed (an engine re-uploads those);
+//   3. nav      LiveWorld::update_nav takes the same dirty chunks;
 //   4. path     an agent walking north across the trench re-plans its path
-//               from where it stands (NavQuery::find_path) and takes a step;
+//               from where it stands (the live world's NavQuery) and takes a step;
 //   5. queries  ray casts find the ground under the player and the agent,
-//               and a fan of 32 rays looks ahead of the player (Queries).
+//               and a fan of 32 rays looks ahead of the player (Queries);
+//               LiveWorld::update_queries then frees what edits replaced.
 // It prints each frame's times as a markdown table, then the median, p95
 // and max of each column. With --png DIR it saves a few frames as .ldc
 // files and renders them through the ldc tool (`ldc render`) with the
@@ -29,12 +32,9 @@
 #include <string>
 #include <vector>
 
-#include "contour/contour.h"
-#include "csg/csg.h"
 #include "ldc/io.h"
-#include "ldc/query.h"
 #include "ldc/terrain.h"
-#include "nav/nav.h"
+#include "live/live.h"
 
 namespace {
 
@@ -83,7 +83,7 @@ bool parse_options(int argc, char** argv, Options* o) {
 // One frame's measurements.
 struct Frame {
   double edit_ms = 0, remesh_ms = 0, nav_ms = 0, path_ms = 0, query_ms = 0;
-  size_t dirty = 0, remeshed = 0;
+  size_t dirty = 0, remeshed = 0, changed_meshes = 0;
   ldc::PathStatus path_status = ldc::PathStatus::kComplete;
   double path_length = 0;
   bool path_found = false;
@@ -92,11 +92,7 @@ struct Frame {
 
 // What the session keeps between frames.
 struct Session {
-  ldc::WorldEditor editor;
-  ldc::ChunkedMesh mesh;
-  ldc::NavMesh nav;
-  ldc::NavQuery path_query{nav};  // kept across frames: its search arrays are reused
-  ldc::Queries queries;
+  ldc::LiveWorld live;
   glm::dvec3 player{0.0};
   glm::dvec3 agent{0.0};
   glm::dvec3 goal{0.0};
@@ -106,8 +102,7 @@ struct Session {
   // dig starts from the bottom of the last one).
   std::vector<glm::dvec3> script;
 
-  Session(ldc::World world, ldc::NavMesh n)
-      : editor(std::move(world)), nav(std::move(n)), queries(editor.world()) {}
+  explicit Session(ldc::LiveWorld l) : live(std::move(l)) {}
 };
 
 // The ground under (x, y): a ray cast straight down from above the landscape.
@@ -133,7 +128,7 @@ double apply_edit(Session& s, int frame) {
                                : ldc::Brush::sphere(p, 1.2);
   const ldc::EditOp op = frame % 5 == 4 ? ldc::EditOp::kAdd : ldc::EditOp::kSubtract;
   const Clock::time_point start = Clock::now();
-  ldc::Result<ldc::EditReceipt> r = s.editor.apply(brush, op);
+  ldc::Result<ldc::EditReceipt> r = s.live.apply(brush, op);
   const double ms = ms_since(start);
   if (!r.ok()) std::fprintf(stderr, "frame %d: edit: %s\n", frame, r.status().to_string().c_str());
   return ms;
@@ -159,20 +154,21 @@ Frame play_frame(Session& s, int frame) {
   s.player = s.script[size_t(frame)];
   f.edit_ms = apply_edit(s, frame);
 
-  const std::vector<ldc::DirtyChunk> dirty = s.editor.take_dirty();
-  f.dirty = dirty.size();
+  // Every consumer up to date at once: re-mesh, nav, query caches.
+  ldc::Result<ldc::LiveUpdate> u = s.live.update();
+  if (u.ok()) {
+    f.dirty = u->dirty_chunks;
+    f.remesh_ms = 1000.0 * u->mesh_seconds;
+    f.nav_ms = 1000.0 * u->nav_seconds;
+    f.remeshed = u->chunks_remeshed;
+    f.changed_meshes = u->meshes.size();  // what an engine re-uploads this frame
+  } else {
+    std::fprintf(stderr, "frame %d: update: %s\n", frame, u.status().to_string().c_str());
+  }
+
   Clock::time_point t = Clock::now();
-  ldc::Result<size_t> remeshed = s.mesh.update(s.editor.world(), dirty);
-  f.remesh_ms = ms_since(t);
-  f.remeshed = remeshed.ok() ? remeshed.value() : 0;
-
-  t = Clock::now();
-  ldc::Result<ldc::NavUpdateStats> nav = s.nav.update(s.editor.world(), dirty);
-  f.nav_ms = ms_since(t);
-  if (!nav.ok()) std::fprintf(stderr, "frame %d: nav: %s\n", frame, nav.status().to_string().c_str());
-
-  t = Clock::now();
-  ldc::Result<ldc::NavPath> path = s.path_query.find_path(s.agent, s.goal);
+  ldc::Result<ldc::NavPath> path = ldc::Status(ldc::ErrorCode::kInternal, "no path query");
+  if (ldc::Result<ldc::NavQuery*> query = s.live.path_query(); query.ok()) path = (*query)->find_path(s.agent, s.goal);
   f.path_ms = ms_since(t);
   if (path.ok()) {
     f.path_found = true;
@@ -183,20 +179,20 @@ Frame play_frame(Session& s, int frame) {
   }
 
   t = Clock::now();
-  const std::optional<glm::dvec3> under_player = ground(s.queries, s.player.x, s.player.y);
-  const std::optional<glm::dvec3> under_agent = ground(s.queries, s.agent.x, s.agent.y);
+  const ldc::Queries& queries = s.live.queries();
+  const std::optional<glm::dvec3> under_player = ground(queries, s.player.x, s.player.y);
+  const std::optional<glm::dvec3> under_agent = ground(queries, s.agent.x, s.agent.y);
   std::vector<ldc::Ray> fan(32);
   for (size_t i = 0; i < fan.size(); ++i) {
     const double a = -0.8 + 1.6 * double(i) / double(fan.size() - 1);
     fan[i] = {s.player + glm::dvec3(0.0, 0.0, 1.7), {std::cos(a), std::sin(a), -0.3}, 30.0};
   }
   std::vector<ldc::RayHit> hits(fan.size());
-  const ldc::Status fan_status = s.queries.ray_cast(fan, hits);
+  const ldc::Status fan_status = queries.ray_cast(fan, hits);
   f.query_ms = ms_since(t);
   if (!fan_status.ok()) std::fprintf(stderr, "frame %d: ray fan: %s\n", frame, fan_status.to_string().c_str());
   if (!under_player) std::fprintf(stderr, "frame %d: no ground under the player at (%.1f, %.1f) after digging at z = %.2f\n", frame, s.player.x, s.player.y, s.player.z);
   if (!under_agent) std::fprintf(stderr, "frame %d: no ground under the agent at (%.1f, %.1f)\n", frame, s.agent.x, s.agent.y);
-  s.queries.refresh();  // once per frame, when no query runs
   return f;
 }
 
@@ -208,16 +204,18 @@ double percentile(std::vector<double> v, double p) {
 }
 
 void print_table(const std::vector<Frame>& frames, bool rows) {
-  std::printf("| frame | dirty chunks | edit ms | re-mesh ms | nav update ms | path ms | path | queries ms | total ms |\n");
-  std::printf("|---:|---:|---:|---:|---:|---:|---|---:|---:|\n");
+  std::printf("| frame | dirty chunks | changed meshes | edit ms | re-mesh ms | nav update ms | path ms | path | "
+              "queries ms | total ms |\n");
+  std::printf("|---:|---:|---:|---:|---:|---:|---:|---|---:|---:|\n");
   if (rows) {
     for (size_t i = 0; i < frames.size(); ++i) {
       const Frame& f = frames[i];
       const std::string path = f.path_found ? std::string(ldc::path_status_name(f.path_status)) + " " +
                                                   std::to_string(int(std::lround(f.path_length))) + " m"
                                             : "no floor";
-      std::printf("| %zu | %zu | %.2f | %.2f | %.2f | %.2f | %s | %.2f | %.2f |\n", i, f.dirty, f.edit_ms,
-                  f.remesh_ms, f.nav_ms, f.path_ms, path.c_str(), f.query_ms, f.total_ms());
+      std::printf("| %zu | %zu | %zu | %.2f | %.2f | %.2f | %.2f | %s | %.2f | %.2f |\n", i, f.dirty,
+                  f.changed_meshes, f.edit_ms, f.remesh_ms, f.nav_ms, f.path_ms, path.c_str(), f.query_ms,
+                  f.total_ms());
     }
   }
   auto column = [&](double (*get)(const Frame&)) {
@@ -232,7 +230,7 @@ void print_table(const std::vector<Frame>& frames, bool rows) {
   const char* names[3] = {"median", "p95", "max"};
   const double ps[3] = {0.5, 0.95, 1.0};
   for (int r = 0; r < 3; ++r) {
-    std::printf("| **%s** | | %.2f | %.2f | %.2f | %.2f | | %.2f | %.2f |\n", names[r], percentile(cols[0], ps[r]),
+    std::printf("| **%s** | | | %.2f | %.2f | %.2f | %.2f | | %.2f | %.2f |\n", names[r], percentile(cols[0], ps[r]),
                 percentile(cols[1], ps[r]), percentile(cols[2], ps[r]), percentile(cols[3], ps[r]),
                 percentile(cols[4], ps[r]), percentile(cols[5], ps[r]));
   }
@@ -248,7 +246,7 @@ bool render_frame(const Session& s, const Options& o, int frame) {
   const std::string ldc_path = (dir / (std::string(stem) + ".ldc")).string();
   const std::string overlay_path = (dir / (std::string(stem) + ".json")).string();
   const std::string png_path = (dir / (std::string(stem) + ".png")).string();
-  if (ldc::Status st = ldc::save_world(s.editor.world(), ldc_path); !st.ok()) {
+  if (ldc::Status st = ldc::save_world(s.live.world(), ldc_path); !st.ok()) {
     std::fprintf(stderr, "%s\n", st.to_string().c_str());
     return false;
   }
@@ -284,29 +282,24 @@ int main(int argc, char** argv) {
   if (!world.ok()) return std::fprintf(stderr, "%s\n", world.status().to_string().c_str()), 1;
   const double terrain_ms = ms_since(t);
   t = Clock::now();
-  ldc::Result<ldc::NavMesh> nav = ldc::NavMesh::build(world.value(), {});
-  if (!nav.ok()) return std::fprintf(stderr, "%s\n", nav.status().to_string().c_str()), 1;
-  const double nav_ms = ms_since(t);
-  Session s(std::move(world).value(), std::move(nav).value());
-  t = Clock::now();
-  if (ldc::Status st = s.mesh.build(s.editor.world()); !st.ok()) {
-    return std::fprintf(stderr, "%s\n", st.to_string().c_str()), 1;
-  }
-  const double mesh_ms = ms_since(t);
-  const std::optional<glm::dvec3> start = ground(s.queries, 24.0, 10.0);
-  const std::optional<glm::dvec3> goal = ground(s.queries, 24.0, 38.0);
+  ldc::Result<ldc::LiveWorld> live = ldc::LiveWorld::create(std::move(world).value(), {.meshes = true, .nav = true});
+  if (!live.ok()) return std::fprintf(stderr, "%s\n", live.status().to_string().c_str()), 1;
+  const double live_ms = ms_since(t);
+  Session s(std::move(live).value());
+  const std::optional<glm::dvec3> start = ground(s.live.queries(), 24.0, 10.0);
+  const std::optional<glm::dvec3> goal = ground(s.live.queries(), 24.0, 38.0);
   if (!start || !goal) return std::fprintf(stderr, "no ground under the agent's start or goal\n"), 1;
   s.agent = *start;
   s.goal = *goal;
   for (int i = 0; i < o.frames; ++i) {
     const glm::dvec2 xy = player_xy(i, o.frames);
-    const std::optional<glm::dvec3> g = ground(s.queries, xy.x, xy.y);
+    const std::optional<glm::dvec3> g = ground(s.live.queries(), xy.x, xy.y);
     if (!g) return std::fprintf(stderr, "no ground under the player at (%.1f, %.1f)\n", xy.x, xy.y), 1;
     s.script.push_back(*g);
   }
   std::printf("# game_loop: %d frames on the default landscape (48 x 48 m, h = 0.2 m)\n\n", o.frames);
-  std::printf("setup: landscape %.0f ms, navmesh %.0f ms, mesh %.0f ms (%zu chunk meshes)\n\n", terrain_ms,
-              nav_ms, mesh_ms, s.mesh.chunks().size());
+  std::printf("setup: landscape %.0f ms, live world (chunk meshes and nav mesh) %.0f ms (%zu chunk meshes)\n\n",
+              terrain_ms, live_ms, s.live.meshes()->chunks().size());
 
   std::vector<Frame> frames;
   const int render_every = std::max(1, o.frames / 3);

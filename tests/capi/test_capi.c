@@ -68,6 +68,19 @@ static void null_handles_are_refused_by_name(void) {
   ldc_cascades_destroy(NULL);
 }
 
+static void thread_cap_is_set_and_lifted(void) {
+  g_case = "thread_cap_is_set_and_lifted";
+  const int32_t uncapped = ldc_max_threads();
+  CHECK(uncapped >= 1);
+  CHECK_STATUS(ldc_set_max_threads(1), LDC_OK);
+  CHECK(ldc_max_threads() == 1);
+  CHECK_STATUS(ldc_set_max_threads(-2), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "-2") != NULL);
+  CHECK(ldc_max_threads() == 1); /* a refused call changes nothing */
+  CHECK_STATUS(ldc_set_max_threads(0), LDC_OK);
+  CHECK(ldc_max_threads() == uncapped);
+}
+
 static void bad_world_config_is_refused(void) {
   g_case = "bad_world_config_is_refused";
   ldc_world_config c;
@@ -431,6 +444,10 @@ static void cascades_outliving_their_world_refuse_updates(void) {
   const double camera[3] = {0, 0, 0};
   CHECK_STATUS(ldc_cascades_update_level(cas, 0, camera, NULL), LDC_INVALID_ARGUMENT);
   CHECK(strstr(ldc_last_error(), "destroyed") != NULL);
+  ldc_gbuffer_buffers b; /* what was voxelized can still be read */
+  memset(&b, 0, sizeof b);
+  CHECK_STATUS(ldc_cascades_read_level(cas, 0, &b), LDC_OK);
+  CHECK(b.texel_count == 6u * 8u * 8u * 8u);
   ldc_cascades_destroy(cas);
 }
 
@@ -439,6 +456,7 @@ int main(int argc, char** argv) {
   version_matches_the_header();
   null_handles_are_refused_by_name();
   bad_world_config_is_refused();
+  thread_cap_is_set_and_lifted();
   missing_file_is_named();
   ldc_world* w = small_landscape();
   if (!w) return 1;
