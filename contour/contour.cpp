@@ -12,7 +12,7 @@
 
 #include "contour/detail/mesh_patch.h"
 #include "contour/detail/region_mesher.h"
-#include "ldc/detail/ray_math.h"
+#include "internal/ray_math.h"
 
 namespace ldc {
 

@@ -26,7 +26,7 @@
 #include <utility>
 
 #include "contour/detail/export.h"
-#include "ldc/detail/vec_text.h"
+#include "internal/vec_text.h"
 
 namespace ldc {
 namespace export_detail {

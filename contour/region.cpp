@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "ldc/detail/ray_math.h"
+#include "internal/ray_math.h"
 
 namespace ldc::detail {
 

@@ -7,7 +7,7 @@
 
 #include "csg/csg.h"
 #include "csg/detail/merge.h"
-#include "ldc/detail/build_common.h"
+#include "internal/build_common.h"
 
 namespace ldc {
 namespace {

@@ -7,8 +7,8 @@
 
 #include "csg/csg.h"
 #include "csg/detail/merge.h"
-#include "ldc/detail/build_common.h"
-#include "ldc/detail/ray_math.h"
+#include "internal/build_common.h"
+#include "internal/ray_math.h"
 
 namespace ldc {
 

@@ -4,8 +4,8 @@
 
 #include <tbb/parallel_for.h>
 
-#include "ldc/detail/build_common.h"
-#include "ldc/detail/ray_math.h"
+#include "internal/build_common.h"
+#include "internal/ray_math.h"
 
 namespace ldc::detail {
 namespace {

@@ -6,7 +6,7 @@
 #include <stb_image.h>
 
 #include "ldc/build.h"
-#include "ldc/detail/build_common.h"
+#include "internal/build_common.h"
 
 namespace ldc {
 namespace {

@@ -11,7 +11,7 @@
 #include <cstring>
 #include <numeric>
 
-#include "ldc/detail/vec_text.h"
+#include "internal/vec_text.h"
 
 namespace ldc {
 namespace {

@@ -6,9 +6,9 @@
 
 #include <tbb/parallel_for.h>
 
-#include "ldc/detail/build_common.h"
+#include "internal/build_common.h"
 #include "ldc/detail/mesh_raster.h"
-#include "ldc/detail/ray_math.h"
+#include "internal/ray_math.h"
 
 namespace ldc::detail {
 

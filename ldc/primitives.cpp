@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "ldc/build.h"
-#include "ldc/detail/build_common.h"
+#include "internal/build_common.h"
 
 namespace ldc {
 

@@ -8,7 +8,7 @@
 #include <cstring>
 #include <limits>
 
-#include "ldc/detail/ray_math.h"
+#include "internal/ray_math.h"
 
 namespace ldc {
 

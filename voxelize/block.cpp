@@ -6,7 +6,7 @@
 #include <cassert>
 #include <cmath>
 
-#include "ldc/detail/ray_math.h"
+#include "internal/ray_math.h"
 
 namespace ldc::detail {
 namespace {

@@ -1,5 +1,5 @@
 # Installs the build into a scratch prefix, checks that the installed public
-# headers include nothing from CGAL, OpenVDB, Embree or ldc's detail/
+# headers include nothing from CGAL, OpenVDB, Embree, a detail/ folder or internal/
 # folders, then configures, builds and runs tests/install/consumer against
 # the package with find_package(ldc). Run by ctest (label install):
 #   cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -P run_install_test.cmake
@@ -31,17 +31,17 @@ if(header_count EQUAL 0)
   message(FATAL_ERROR "no headers installed under ${prefix}/include")
 endif()
 foreach(h ${headers})
-  if(h MATCHES "/detail/")
+  if(h MATCHES "/detail/|/internal/")
     message(FATAL_ERROR "an internal header was installed: ${h}")
   endif()
   file(STRINGS ${h} includes REGEX "^[ \t]*#[ \t]*include")
   foreach(line ${includes})
-    if(line MATCHES "CGAL/|openvdb/|embree|/detail/")
+    if(line MATCHES "CGAL/|openvdb/|embree|/detail/|internal/")
       message(FATAL_ERROR "${h} includes a header that must stay out of the public API: ${line}")
     endif()
   endforeach()
 endforeach()
-message("installed ${header_count} public headers; none includes CGAL, OpenVDB, Embree or detail/")
+message("installed ${header_count} public headers; none includes CGAL, OpenVDB, Embree, detail/ or internal/")
 if(NOT EXISTS ${prefix}/lib/cmake/ldc/ldcConfig.cmake AND NOT EXISTS ${prefix}/lib64/cmake/ldc/ldcConfig.cmake)
   message(FATAL_ERROR "ldcConfig.cmake was not installed under ${prefix}/lib/cmake/ldc")
 endif()

@@ -1,0 +1,22 @@
+# Fails when a module includes another module's detail/ headers: what modules
+# share lives in internal/ (see internal/README.md).
+# Usage: cmake -DSOURCE_DIR=<repo> -P check_module_includes.cmake
+set(modules ldc contour csg nav voxelize gi_bridge live meshio render capi tools examples)
+set(violations 0)
+foreach(module ${modules})
+  file(GLOB_RECURSE sources ${SOURCE_DIR}/${module}/*.h ${SOURCE_DIR}/${module}/*.cpp ${SOURCE_DIR}/${module}/*.c)
+  foreach(source ${sources})
+    file(STRINGS ${source} includes REGEX "^[ \t]*#[ \t]*include[ \t]*\"[a-z_]+/detail/")
+    foreach(line ${includes})
+      string(REGEX MATCH "\"([a-z_]+)/detail/" _ "${line}")
+      if(NOT CMAKE_MATCH_1 STREQUAL module)
+        message(SEND_ERROR "${source}: ${line} (module ${module} includes ${CMAKE_MATCH_1}/detail/)")
+        math(EXPR violations "${violations} + 1")
+      endif()
+    endforeach()
+  endforeach()
+endforeach()
+if(violations GREATER 0)
+  message(FATAL_ERROR "${violations} includes of another module's detail/ headers")
+endif()
+message("no module includes another module's detail/ headers")
