@@ -5,7 +5,7 @@
 #include <sstream>
 
 #include "common.h"
-#include "ldc/detail/vec_text.h"
+#include "internal/vec_text.h"
 
 namespace ldc::tool {
 

@@ -1,6 +1,7 @@
 // ldc build: mesh, primitive, heightfield or landscape -> .ldc
 #include <cstdio>
 #include <memory>
+#include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -78,10 +79,12 @@ Result<World> build_world(const BuildArgs& a, Context* ctx, BuildReport* report)
   }
   TerrainConfig tc;
   tc.seed = a.seed;
-  glm::dvec3 size;
-  if (!parse_vec3(a.size + ",0", &size)) return Status(ErrorCode::kInvalidArgument, "--size takes X,Y in metres");
-  tc.size_x = size.x;
-  tc.size_y = size.y;
+  std::vector<double> size;
+  if (!parse_numbers(a.size, &size) || size.size() != 2) {
+    return Status(ErrorCode::kInvalidArgument, "--size '" + a.size + "': expected two finite numbers X,Y (m)");
+  }
+  tc.size_x = size[0];
+  tc.size_y = size[1];
   double h = a.grid.cell_size > 0.0 ? a.grid.cell_size : 0.2;
   return build_terrain(tc, h, a.grid.chunk_size, ctx, report);
 }
@@ -129,25 +132,25 @@ void add_build_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("input", args->input, "Mesh file (.obj .ply .stl .off)");
   cmd->add_option("-o,--output", args->output, "Output .ldc file")->required();
   cmd->add_option("--cells", args->grid.cells, "Cells along the longest axis of the input")->capture_default_str();
-  cmd->add_option("--cell-size", args->grid.cell_size, "Cell size h in metres (overrides --cells)");
-  cmd->add_option("--chunk", args->grid.chunk_size, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
+  cmd->add_option("--cell-size", args->grid.cell_size, "Cell size h (m); overrides --cells");
+  cmd->add_option("--chunk-size,--chunk", args->grid.chunk_size, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
   cmd->add_option("--padding", args->grid.padding, "Empty cells around the input")->capture_default_str();
   cmd->add_option("--primitive", args->primitive, "sphere | box | capsule | cylinder");
-  cmd->add_option("--radius", args->radius, "Primitive radius (m)");
-  cmd->add_option("--half-height", args->half_height, "Capsule/cylinder half height (m)");
-  cmd->add_option("--half-extents", args->half_extents, "Box half extents x,y,z (m)");
-  cmd->add_option("--translate", args->translate, "Primitive translation x,y,z (m)");
-  cmd->add_option("--scale", args->scale, "Primitive scale x,y,z");
-  cmd->add_option("--rotate", args->rotate_deg, "Primitive rotation about --axis (degrees)");
-  cmd->add_option("--axis", args->axis, "Rotation axis x,y,z");
+  cmd->add_option("--radius", args->radius, "Primitive radius (m)")->capture_default_str();
+  cmd->add_option("--half-height", args->half_height, "Capsule/cylinder half height (m)")->capture_default_str();
+  cmd->add_option("--half-extents", args->half_extents, "Box half extents x,y,z (m)")->capture_default_str();
+  cmd->add_option("--translate", args->translate, "Primitive translation x,y,z (m)")->capture_default_str();
+  cmd->add_option("--scale", args->scale, "Primitive scale x,y,z")->capture_default_str();
+  cmd->add_option("--rotate", args->rotate_deg, "Primitive rotation about --axis (degrees)")->capture_default_str();
+  cmd->add_option("--axis", args->axis, "Rotation axis x,y,z of --rotate")->capture_default_str();
   cmd->add_option("--heightfield", args->heightfield, "Grayscale PNG heightfield");
-  cmd->add_option("--spacing", args->spacing, "Heightfield sample spacing (m)");
-  cmd->add_option("--height-scale", args->height_scale, "Heightfield height of white (m)");
-  cmd->add_option("--base", args->base, "Heightfield height of black (m)");
-  cmd->add_option("--floor", args->floor, "Heightfield floor (m)");
+  cmd->add_option("--spacing", args->spacing, "Heightfield sample spacing (m)")->capture_default_str();
+  cmd->add_option("--height-scale", args->height_scale, "Heightfield height of white (m)")->capture_default_str();
+  cmd->add_option("--base", args->base, "Heightfield height of black (m)")->capture_default_str();
+  cmd->add_option("--floor", args->floor, "Heightfield floor (m)")->capture_default_str();
   cmd->add_flag("--terrain", args->terrain, "The procedural landscape (default scene)");
-  cmd->add_option("--seed", args->seed, "Landscape seed");
-  cmd->add_option("--size", args->size, "Landscape size X,Y (m)");
+  cmd->add_option("--seed", args->seed, "Landscape seed")->capture_default_str();
+  cmd->add_option("--size", args->size, "Landscape size X,Y (m)")->capture_default_str();
   cmd->add_flag("--validate", args->validate, "Validate the result (exit 2 if invalid)");
   cmd->callback([args, &common] {
     int code = run_build(*args, common);

@@ -20,7 +20,9 @@ Output (stdout, or -o FILE), drawable with `ldc render --overlay FILE`:
    "nav": {"floors", "walkable", "regions", "components", "memory_bytes", "build_seconds"},
    "query_seconds"}
 "unreachable": the goal lies on another walkable island (or has no floor near it); the path
-ends at the start island's point nearest the goal. The exit status is 0 for every status.
+ends at the start island's point nearest the goal. "out_of_nodes": the search spent --max-nodes
+(default 2048, the library's budget) before reaching the goal; the path ends at the explored region
+nearest the goal: raise --max-nodes for long paths. The exit status is 0 for every status.
 )";
 
 struct PathArgs {
@@ -29,7 +31,7 @@ struct PathArgs {
   std::string output;
   std::string up = "auto";
   double cell_size = 0.3;
-  int max_nodes = 65536;
+  int max_nodes = 2048;  // NavQuery's default budget (nav/nav.h)
   NavConfig agent;
 };
 
@@ -143,7 +145,8 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--agent-radius", args->agent.agent_radius, "Agent radius: erosion from walls and drops (m)")->capture_default_str();
   cmd->add_option("--max-climb", args->agent.max_climb, "Highest step between neighbouring floors (m)")->capture_default_str();
   cmd->add_option("--max-slope", args->agent.max_slope_degrees, "Steepest walkable floor (degrees)")->capture_default_str();
-  cmd->add_option("--max-nodes", args->max_nodes, "A* node budget (regions)")->capture_default_str();
+  cmd->add_option("--max-nodes", args->max_nodes, "A* node budget in regions, clamped to 16 .. 1048576 (default: NavQuery's, as in nav/nav.h)")
+      ->capture_default_str();
   cmd->add_option("-o,--output", args->output, "Write the path JSON here instead of stdout");
   cmd->footer(kPathHelp);
   cmd->callback([args, &common] {

@@ -16,7 +16,7 @@
 
 #include "camera.h"
 #include "common.h"
-#include "ldc/detail/vec_text.h"
+#include "internal/vec_text.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
 

@@ -1,6 +1,8 @@
 // ldc terrain: write the built-in default landscape.
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "common.h"
 #include "ldc/io.h"
@@ -12,13 +14,22 @@ namespace {
 struct TerrainArgs {
   std::string output = "default.ldc";
   TerrainConfig config;
+  std::string size;  // --size X,Y; empty = --size-x / --size-y (or the defaults)
   double cell_size = 0.2;
   int chunk = 32;
   bool validate = false;
 };
 
-int run_terrain(const TerrainArgs& a, const CommonOptions& common) {
+int run_terrain(TerrainArgs a, const CommonOptions& common) {
   set_thread_count(common.threads);
+  if (!a.size.empty()) {
+    std::vector<double> v;
+    if (!parse_numbers(a.size, &v) || v.size() != 2) {
+      return fail("terrain", "--size '" + a.size + "': expected two finite numbers X,Y (m)");
+    }
+    a.config.size_x = v[0];
+    a.config.size_y = v[1];
+  }
   ProgressBar bar(!common.quiet);
   BuildReport report;
   Result<World> w = build_terrain(a.config, a.cell_size, a.chunk, bar.context(), &report);
@@ -45,12 +56,19 @@ void add_terrain_command(CLI::App& app, CommonOptions& common) {
   CLI::App* cmd = app.add_subcommand("terrain", "Write the default procedural landscape (caves, overhangs, arches)");
   cmd->add_option("-o,--output", args->output, "Output .ldc file")->capture_default_str();
   cmd->add_option("--seed", args->config.seed, "Landscape seed")->capture_default_str();
-  cmd->add_option("--size-x", args->config.size_x, "Extent along x (m)")->capture_default_str();
-  cmd->add_option("--size-y", args->config.size_y, "Extent along y (m)")->capture_default_str();
+  char size_default[64];
+  std::snprintf(size_default, sizeof(size_default), "%g,%g", args->config.size_x, args->config.size_y);
+  CLI::Option* size = cmd->add_option("--size", args->size, "Landscape size X,Y (m)")->default_str(size_default);
+  // Deprecated spellings of --size, kept working (hidden from the help).
+  CLI::Option* size_x = cmd->add_option("--size-x", args->config.size_x, "Extent along x (m); use --size X,Y")->group("");
+  CLI::Option* size_y = cmd->add_option("--size-y", args->config.size_y, "Extent along y (m); use --size X,Y")->group("");
   cmd->add_option("--cell-size", args->cell_size, "Cell size h (m)")->capture_default_str();
-  cmd->add_option("--chunk", args->chunk, "Chunk size in cells")->capture_default_str();
+  cmd->add_option("--chunk-size,--chunk", args->chunk, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
   cmd->add_flag("--validate", args->validate, "Validate the result (exit 2 if invalid)");
-  cmd->callback([args, &common] {
+  cmd->callback([args, &common, size, size_x, size_y] {
+    if (size->count() > 0 && (size_x->count() > 0 || size_y->count() > 0)) {
+      throw CLI::RuntimeError(fail("terrain", "give --size X,Y or the deprecated --size-x / --size-y, not both"));
+    }
     int code = run_terrain(*args, common);
     if (code != 0) throw CLI::RuntimeError(code);
   });

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "common.h"
-#include "ldc/detail/vec_text.h"
+#include "internal/vec_text.h"
 #include "ldc/io.h"
 #include "voxelize/vdb.h"
 #include "voxelize/voxelize.h"
@@ -42,7 +42,7 @@ Result<int> parse_axis(const std::string& a) {
   if (a == "x") return 0;
   if (a == "y") return 1;
   if (a == "z") return 2;
-  return Status(ErrorCode::kInvalidArgument, "--axis '" + a + "': use x, y or z");
+  return Status(ErrorCode::kInvalidArgument, "--ray-axis '" + a + "': use x, y or z");
 }
 
 nlohmann::json box_json(const VoxelBox& b) {
@@ -165,7 +165,7 @@ void add_voxelize_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--cascades", args->cascades, "Camera-centred cascade levels K (0 = one dense grid)");
   cmd->add_option("--resolution", args->resolution, "Voxels per axis of each cascade level")->capture_default_str();
   cmd->add_option("--camera", args->camera, "Cascade centre x,y,z (m); default: the centre of the solid");
-  cmd->add_option("--axis", args->axis, "Ray family integrated for the occupancy: x, y or z")->capture_default_str();
+  cmd->add_option("--ray-axis,--axis", args->axis, "Ray family integrated for the occupancy: x, y or z")->capture_default_str();
   cmd->add_flag("--occupancy-only", args->occupancy_only, "Dense grid: occupancy only, no normal/albedo (faster)");
   cmd->callback([args, &common] {
     int code = run_voxelize(*args, common);

@@ -11,7 +11,7 @@
 
 #include <tbb/global_control.h>
 
-#include "ldc/detail/vec_text.h"
+#include "internal/vec_text.h"
 
 namespace ldc::tool {
 

@@ -74,8 +74,8 @@ void add_mesh_output_options(CLI::App* cmd, MeshOutputArgs& a) {
 
 void add_grid_options(CLI::App* cmd, GridConfig& grid, const std::string& cells_of) {
   cmd->add_option("--cells", grid.cells, "Cells along the longest axis of " + cells_of)->capture_default_str();
-  cmd->add_option("--cell-size", grid.cell_size, "Cell size h (overrides --cells)");
-  cmd->add_option("--chunk,--chunk-size", grid.chunk_size, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
+  cmd->add_option("--cell-size", grid.cell_size, "Cell size h (m); overrides --cells");
+  cmd->add_option("--chunk-size,--chunk", grid.chunk_size, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
 }
 
 Status check_mesh_output(const MeshOutputArgs& args) {

@@ -19,7 +19,7 @@ struct MeshOutputArgs {
 // -o and the contouring options: --method, --iterations, --relax, --slack.
 void add_mesh_output_options(CLI::App* cmd, MeshOutputArgs& args);
 
-// --cells, --cell-size and --chunk (alias --chunk-size); `cells_of` says
+// --cells, --cell-size and --chunk-size (deprecated alias --chunk); `cells_of` says
 // which bounding box --cells divides.
 void add_grid_options(CLI::App* cmd, GridConfig& grid, const std::string& cells_of);
 
