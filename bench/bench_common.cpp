@@ -1,4 +1,5 @@
 #include "bench_common.h"
+#include "meshio/meshio.h"
 
 #include <cstdio>
 #include <cstdlib>

@@ -18,7 +18,7 @@
 
 #include "bench_common.h"
 #include "contour/contour.h"
-#include "contour/export.h"
+#include "meshio/meshio.h"
 #include "ldc/build.h"
 #include "meshdist.h"
 #include "svg_plot.h"

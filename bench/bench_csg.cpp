@@ -25,7 +25,7 @@
 
 #include "bench_common.h"
 #include "contour/contour.h"
-#include "contour/export.h"
+#include "meshio/meshio.h"
 #include "csg/csg.h"
 #include "csg_peers.h"
 #include "ldc/build.h"

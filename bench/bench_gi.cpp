@@ -27,6 +27,7 @@
 #include "ldc/build.h"
 #include "ldc/mesh.h"
 #include "ldc/terrain.h"
+#include "meshio/meshio.h"
 
 namespace {
 

@@ -35,6 +35,7 @@
 #include "ldc/build.h"
 #include "ldc/query.h"
 #include "ldc/terrain.h"
+#include "meshio/meshio.h"
 
 namespace {
 

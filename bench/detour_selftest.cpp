@@ -16,6 +16,7 @@
 
 #include "detour_peer.h"
 #include "ldc/mesh.h"
+#include "meshio/meshio.h"
 
 namespace {
 

@@ -12,6 +12,7 @@
 #include <tbb/global_control.h>
 
 #include "meshdist.h"
+#include "meshio/meshio.h"
 
 namespace {
 

@@ -27,7 +27,7 @@ set_target_properties(ldc_csg PROPERTIES EXPORT_NAME csg)
 set_target_properties(ldc_nav PROPERTIES EXPORT_NAME nav)
 set_target_properties(ldc_voxelize PROPERTIES EXPORT_NAME voxelize)
 set_target_properties(ldc_live PROPERTIES EXPORT_NAME live)
-install(FILES ldc/build.h ldc/context.h ldc/io.h ldc/mesh.h ldc/query.h ldc/status.h
+install(FILES ldc/build.h ldc/context.h ldc/io.h ldc/materials.h ldc/mesh.h ldc/query.h ldc/status.h
               ldc/terrain.h ldc/version.h ldc/world.h
         DESTINATION ${ldc_header_dir}/ldc COMPONENT dev)
 install(FILES contour/contour.h contour/export.h contour/openmesh.h
@@ -36,6 +36,9 @@ install(FILES csg/csg.h DESTINATION ${ldc_header_dir}/csg COMPONENT dev)
 install(FILES nav/nav.h DESTINATION ${ldc_header_dir}/nav COMPONENT dev)
 install(FILES voxelize/voxelize.h DESTINATION ${ldc_header_dir}/voxelize COMPONENT dev)
 install(FILES live/live.h DESTINATION ${ldc_header_dir}/live COMPONENT dev)
+list(APPEND ldc_export_targets ldc_render)
+set_target_properties(ldc_render PROPERTIES EXPORT_NAME render)
+install(FILES render/render.h DESTINATION ${ldc_header_dir}/render COMPONENT dev)
 set(LDC_PACKAGE_HAS_VDB OFF)
 if(TARGET ldc_voxelize_vdb)
   set(LDC_PACKAGE_HAS_VDB ON)

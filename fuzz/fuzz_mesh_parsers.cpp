@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "ldc/mesh.h"
+#include "meshio/meshio.h"
 
 namespace {
 

@@ -103,8 +103,11 @@ struct SkyLight {
   // The same radiance in every direction (exact in this basis).
   static SkyLight uniform(const glm::vec3& radiance);
   // Lobes set to the zenith colour above, mixed to the horizon colour at
-  // z = 0 and the ground colour below (by the lobe's direction's z).
-  static SkyLight gradient(const glm::vec3& zenith, const glm::vec3& horizon, const glm::vec3& ground);
+  // the horizon and the ground colour below, by the lobe's direction's
+  // component along up_axis (0 x, 1 y, 2 z) [Limit: 0, 1, 2; others are z]
+  // [Default: 2, z up].
+  static SkyLight gradient(const glm::vec3& zenith, const glm::vec3& horizon, const glm::vec3& ground,
+                           int up_axis = 2);
   // L_sky(w) for a unit direction.
   glm::vec3 radiance(const glm::vec3& w) const;
 };

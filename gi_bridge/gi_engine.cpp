@@ -32,10 +32,12 @@ SkyLight SkyLight::uniform(const glm::vec3& radiance) {
   return s;
 }
 
-SkyLight SkyLight::gradient(const glm::vec3& zenith, const glm::vec3& horizon, const glm::vec3& ground) {
+SkyLight SkyLight::gradient(const glm::vec3& zenith, const glm::vec3& horizon, const glm::vec3& ground,
+                            int up_axis) {
+  const int up = up_axis >= 0 && up_axis <= 2 ? up_axis : 2;
   SkyLight s;
   for (int i = 0; i < kGiDirections; ++i) {
-    const float z = gi_directions()[size_t(i)].z;
+    const float z = gi_directions()[size_t(i)][up];
     s.amplitude[size_t(i)] = z >= 0.0f ? glm::mix(horizon, zenith, z) : glm::mix(horizon, ground, -z);
   }
   return s;

@@ -399,18 +399,8 @@ Status save_world(const World& world, const std::string& path, const SaveOptions
                   Context* ctx) {
   Result<std::vector<uint8_t>> bytes = serialize_world(world, options, ctx);
   if (!bytes.ok()) return bytes.status();
-  // Write beside the target and rename, so a failed save leaves the old file intact.
-  std::string tmp = path + ".tmp";
-  std::FILE* f = std::fopen(tmp.c_str(), "wb");
-  if (!f) return {ErrorCode::kIoError, path + ": cannot open for writing: " + std::strerror(errno)};
-  size_t n = std::fwrite(bytes.value().data(), 1, bytes.value().size(), f);
-  bool ok = n == bytes.value().size() && std::fflush(f) == 0;
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok || std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    return {ErrorCode::kIoError, path + ": write failed: " + std::strerror(errno)};
-  }
-  return {};
+  const std::vector<uint8_t>& b = bytes.value();
+  return write_file_atomically(path, std::string_view(reinterpret_cast<const char*>(b.data()), b.size()));
 }
 
 Result<World> deserialize_world(std::string_view bytes, std::string_view name,
@@ -465,22 +455,9 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
 }
 
 Result<World> load_world(const std::string& path, const LoadLimits& limits, Context* ctx) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return Status(ErrorCode::kIoError, path + ": cannot open: " + std::strerror(errno));
-  std::string bytes;
-  std::array<char, 1 << 16> buf;
-  size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), f)) > 0) {
-    bytes.append(buf.data(), n);
-    if (bytes.size() > limits.max_file_bytes) {
-      std::fclose(f);
-      return Status(ErrorCode::kTooLarge, path + ": larger than the load limit");
-    }
-  }
-  bool err = std::ferror(f);
-  std::fclose(f);
-  if (err) return Status(ErrorCode::kIoError, path + ": read error");
-  return deserialize_world(bytes, path, limits, ctx);
+  Result<std::string> bytes = read_file(path, limits.max_file_bytes);
+  if (!bytes.ok()) return bytes.status();
+  return deserialize_world(bytes.value(), path, limits, ctx);
 }
 
 }  // namespace ldc

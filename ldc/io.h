@@ -58,4 +58,15 @@ Result<World> load_world(const std::string& path, const LoadLimits& limits = {},
 Result<World> deserialize_world(std::string_view bytes, std::string_view name,
                                 const LoadLimits& limits = {}, Context* ctx = nullptr);
 
+// --- Whole files: what every ldc file (worlds, meshes, images) goes through ---
+
+// Reads the whole file. One larger than max_bytes is refused (kTooLarge)
+// before more than that is read; errors name the path and the system's reason.
+Result<std::string> read_file(const std::string& path, uint64_t max_bytes = UINT64_MAX);
+
+// Writes `bytes` to `path` through `path + ".tmp"`, flushed, then a rename:
+// a failed or killed write leaves any previous file at `path` intact and,
+// on failure, nothing at `path + ".tmp"`.
+Status write_file_atomically(const std::string& path, std::string_view bytes);
+
 }  // namespace ldc

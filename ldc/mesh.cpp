@@ -1,14 +1,10 @@
-// TriangleMesh measures, checks and topology, and the OBJ writer.
+// TriangleMesh measures, checks and topology.
 #include "ldc/mesh.h"
 
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cerrno>
-#include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <numeric>
 
 #include "internal/vec_text.h"
@@ -21,20 +17,6 @@ using detail::is_finite;
 bool indices_valid(const TriangleMesh& mesh, const glm::uvec3& triangle) {
   const size_t count = mesh.positions.size();
   return triangle.x < count && triangle.y < count && triangle.z < count;
-}
-
-void append_number(std::string& out, double value) {
-  char buffer[32];
-  // Shortest text that reads back to the same double, whatever the C locale
-  // (printf's "%.17g" would write "0,5" under a German LC_NUMERIC).
-  auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out.append(buffer, result.ptr);
-}
-
-void append_number(std::string& out, uint64_t value) {
-  char buffer[24];
-  auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  out.append(buffer, result.ptr);
 }
 
 // Welded vertex id per position: positions with equal coordinates share one.
@@ -81,65 +63,6 @@ void count_edges(std::vector<EdgeUse>& uses, MeshTopology& topology) {
     if (balance != 0) ++topology.unbalanced_edges;
     begin = end;
   }
-}
-
-bool writable_material_name(const std::string& name) {
-  return !name.empty() && name.find_first_of("#\r\n") == std::string::npos && name.front() != ' ' &&
-         name.front() != '\t' && name.back() != ' ' && name.back() != '\t';
-}
-
-void append_usemtl(std::string& out, const TriangleMesh& mesh, uint16_t id) {
-  out += "usemtl ";
-  if (id < mesh.material_names.size() && writable_material_name(mesh.material_names[id])) {
-    out += mesh.material_names[id];
-  } else {
-    out += "material_";
-    append_number(out, uint64_t{id});
-  }
-  out += '\n';
-}
-
-std::string format_obj(const TriangleMesh& mesh) {
-  std::string out;
-  out.reserve(mesh.positions.size() * 64 + mesh.triangles.size() * 24);
-  out += "# written by ldc\n";
-  for (const glm::dvec3& p : mesh.positions) {
-    out += "v ";
-    append_number(out, p.x);
-    out += ' ';
-    append_number(out, p.y);
-    out += ' ';
-    append_number(out, p.z);
-    out += '\n';
-  }
-  const bool has_materials = !mesh.triangle_material.empty();
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (has_materials && (t == 0 || mesh.triangle_material[t] != mesh.triangle_material[t - 1])) {
-      append_usemtl(out, mesh, mesh.triangle_material[t]);
-    }
-    out += 'f';
-    for (int corner = 0; corner < 3; ++corner) {
-      out += ' ';
-      append_number(out, uint64_t{mesh.triangles[t][corner]} + 1);
-    }
-    out += '\n';
-  }
-  return out;
-}
-
-Status write_file(const std::string& path, const std::string& bytes) {
-  std::FILE* file = std::fopen(path.c_str(), "wb");
-  if (!file) {
-    return {ErrorCode::kIoError, "cannot create '" + path + "': " + std::strerror(errno)};
-  }
-  const bool written = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
-  const int write_error = errno;
-  const bool closed = std::fclose(file) == 0;
-  if (!written || !closed) {
-    return {ErrorCode::kIoError,
-            "cannot write '" + path + "': " + std::strerror(written ? errno : write_error)};
-  }
-  return {};
 }
 
 }  // namespace
@@ -242,12 +165,6 @@ MeshTopology mesh_topology(const TriangleMesh& mesh) {
   }
   count_edges(uses, topology);
   return topology;
-}
-
-Status save_obj(const TriangleMesh& mesh, const std::string& path) {
-  Status valid = check_mesh(mesh, path);
-  if (!valid.ok()) return valid;
-  return write_file(path, format_obj(mesh));
 }
 
 }  // namespace ldc

@@ -1,9 +1,6 @@
-// Triangle meshes: the in-memory form and the file loaders (OBJ, PLY, STL, OFF).
-//
-// Loaders triangulate polygons, keep OBJ `usemtl` groups as material ids and
-// refuse malformed input with a message naming the file, the line (text
-// formats) or byte offset (binary formats) and the offending value. They never
-// crash and never allocate more than the file's own size justifies.
+// Triangle meshes: the in-memory form the builders and brushes take, and
+// checks on it. Files are read and written by the meshio module
+// (meshio/meshio.h: OBJ, PLY, STL, OFF, GLB, Draco).
 //
 // Units: positions are in the caller's units (metres for the builders and
 // brushes, which take them as world coordinates). Thread safety: the loaders
@@ -62,29 +59,5 @@ struct MeshTopology {
   bool closed() const { return unbalanced_edges == 0; }
 };
 MeshTopology mesh_topology(const TriangleMesh& mesh);
-
-struct LoadOptions {
-  // Refuse files with more triangles than this [Limit: >= 1].
-  size_t max_triangles = size_t{1} << 28;
-};
-
-// Picks the format by extension (.obj .ply .stl .off, case-insensitive).
-Result<TriangleMesh> load_mesh(const std::string& path, const LoadOptions& options = {});
-
-// Parsers over bytes already in memory; `name` is used in messages.
-// Polygons are ear-clipped in their best-fit plane (a k-gon gives k - 2
-// triangles; degenerate ones, and any over 256 corners, are fanned instead).
-// STL corners at exactly the same position are welded into one vertex.
-Result<TriangleMesh> parse_obj(std::string_view bytes, std::string_view name,
-                               const LoadOptions& options = {});
-Result<TriangleMesh> parse_ply(std::string_view bytes, std::string_view name,
-                               const LoadOptions& options = {});
-Result<TriangleMesh> parse_stl(std::string_view bytes, std::string_view name,
-                               const LoadOptions& options = {});
-Result<TriangleMesh> parse_off(std::string_view bytes, std::string_view name,
-                               const LoadOptions& options = {});
-
-// Writes a Wavefront OBJ (positions and faces, `usemtl` groups when materials are set).
-Status save_obj(const TriangleMesh& mesh, const std::string& path);
 
 }  // namespace ldc

@@ -20,6 +20,8 @@ packages=(
   libopenvdb-dev libboost-iostreams-dev libembree-dev librecast-dev
   # gi_bridge (issue 8): Vulkan loader and headers, Mesa's lavapipe (CPU Vulkan), glslc
   libvulkan-dev mesa-vulkan-drivers glslc
+  # outside checks of written files: draco_decoder (node and npm below, for gltf-validator)
+  draco
 )
 
 SUDO=""
@@ -31,9 +33,25 @@ for p in "${packages[@]}"; do
 done
 if [ "${#missing[@]}" -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "install-deps: installing ${missing[*]}"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
-echo "install-deps: installing ${missing[*]}"
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+
+# node and npm: Debian's, unless the machine has its own (a NodeSource nodejs
+# bundles npm and conflicts with Debian's npm package).
+if ! command -v npm >/dev/null 2>&1; then
+  echo "install-deps: installing nodejs npm"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends nodejs npm
+fi
+
+# npm tools the tests check outputs with (versions pinned in tests/js/package-lock.json).
+js_dir="$(cd "$(dirname "$0")/.." && pwd)/tests/js"
+if [ ! -d "$js_dir/node_modules/gltf-validator" ]; then
+  echo "install-deps: npm ci in tests/js (gltf-validator)"
+  (cd "$js_dir" && npm ci --no-audit --no-fund --silent)
+fi

@@ -12,8 +12,8 @@
 #include <tuple>
 #include <vector>
 
-#include "contour/detail/tiny_gltf.h"  // ldc's private copy (libdraco exports another)
-#include "contour/export.h"
+#include "meshio/detail/tiny_gltf.h"  // ldc's private copy (libdraco exports another)
+#include "meshio/meshio.h"
 #include "contour/openmesh.h"
 
 namespace ldc {
@@ -154,7 +154,7 @@ glm::dvec3 as_float(const glm::dvec3& p) {
 Result<ContourMesh> save_and_load(const ContourMesh& mesh, const std::string& name,
                                   const ExportOptions& options = {}) {
   const std::string path = temp_path(name);
-  Status saved = save_contour_mesh(mesh, path, options);
+  Status saved = save_mesh(mesh, path, options);
   if (!saved.ok()) return saved;
   return load_contour_mesh(path);
 }
@@ -173,7 +173,7 @@ TEST_F(ContourExport, UnknownExtensionIsRefusedByName) {
   const Result<MeshFormat> format = mesh_format_from_path("out/mesh.fbx");
   ASSERT_FALSE(format.ok());
   EXPECT_NE(format.status().message().find(".fbx"), std::string::npos) << format.status().message();
-  const Status saved = save_contour_mesh(unit_cube(), temp_path("mesh.fbx"));
+  const Status saved = save_mesh(unit_cube(), temp_path("mesh.fbx"));
   EXPECT_FALSE(saved.ok());
   EXPECT_NE(saved.message().find(".fbx"), std::string::npos);
   EXPECT_FALSE(mesh_format_from_path("dir.obj/noextension").ok());
@@ -200,7 +200,7 @@ TEST_F(ContourExport, ObjIsReadByParseObjWithOneUsemtlPerMaterial) {
   ExportOptions options;
   options.material_names = {"grass", "", "", "", "", "", "", "stone wall"};
   const std::string path = temp_path("parse.obj");
-  ASSERT_TRUE(save_contour_mesh(mesh, path, options).ok());
+  ASSERT_TRUE(save_mesh(mesh, path, options).ok());
   const std::string text = read_bytes(path);
   Result<TriangleMesh> parsed = parse_obj(text, path);
   ASSERT_TRUE(parsed.ok()) << parsed.status().to_string();
@@ -219,11 +219,11 @@ TEST_F(ContourExport, ObjIsReadByParseObjWithOneUsemtlPerMaterial) {
 TEST_F(ContourExport, ObjRefusesMaterialNamesItCannotKeep) {
   ExportOptions options;
   options.material_names = {"a#b"};
-  const Status hash = save_contour_mesh(tetrahedron(), temp_path("names.obj"), options);
+  const Status hash = save_mesh(tetrahedron(), temp_path("names.obj"), options);
   EXPECT_EQ(hash.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(hash.message().find("a#b"), std::string::npos);
   options.material_names = {"same", "", "", "", "", "", "", "same"};
-  EXPECT_EQ(save_contour_mesh(tetrahedron(), temp_path("names.obj"), options).code(),
+  EXPECT_EQ(save_mesh(tetrahedron(), temp_path("names.obj"), options).code(),
             ErrorCode::kInvalidArgument);
 }
 
@@ -243,7 +243,7 @@ TEST_F(ContourExport, PlyRoundTripsEverythingExactlyAndInOrder) {
 TEST_F(ContourExport, PlyIsReadByParsePlyDespiteTheMaterialProperty) {
   const ContourMesh mesh = tetrahedron();
   const std::string path = temp_path("parse.ply");
-  ASSERT_TRUE(save_contour_mesh(mesh, path).ok());
+  ASSERT_TRUE(save_mesh(mesh, path).ok());
   Result<TriangleMesh> parsed = parse_ply(read_bytes(path), path);
   ASSERT_TRUE(parsed.ok()) << parsed.status().to_string();
   EXPECT_EQ(parsed->positions, mesh.positions);
@@ -253,7 +253,7 @@ TEST_F(ContourExport, PlyIsReadByParsePlyDespiteTheMaterialProperty) {
 TEST_F(ContourExport, StlLosesMaterialsButKeepsTriangles) {
   const ContourMesh mesh = unit_cube(glm::dvec3(0.1, 0.2, 0.3));
   const std::string path = temp_path("cube.stl");
-  ASSERT_TRUE(save_contour_mesh(mesh, path).ok());
+  ASSERT_TRUE(save_mesh(mesh, path).ok());
   EXPECT_EQ(read_bytes(path).size(), 84u + 50u * 12u);
   Result<ContourMesh> loaded = load_contour_mesh(path);
   ASSERT_TRUE(loaded.ok()) << loaded.status().to_string();
@@ -287,7 +287,7 @@ TEST_F(ContourExport, GlbPassesTinygltfStructuralCheck) {
   const std::string path = temp_path("check.glb");
   ExportOptions options;
   options.material_names = {"", "dirt"};
-  ASSERT_TRUE(save_contour_mesh(unit_cube(), path, options).ok());
+  ASSERT_TRUE(save_mesh(unit_cube(), path, options).ok());
   ldc_tinygltf::Model model;
   ldc_tinygltf::TinyGLTF loader;
   std::string err, warn;
@@ -347,7 +347,7 @@ TEST_F(ContourExport, EmptyMeshWritesAValidFileForEveryFormat) {
   EXPECT_EQ(err + warn, "");
   EXPECT_TRUE(model.meshes.empty());
   // Draco's encoders refuse (or crash on) a mesh without faces.
-  const Status draco = save_contour_mesh(empty, temp_path("empty.drc"));
+  const Status draco = save_mesh(empty, temp_path("empty.drc"));
   EXPECT_EQ(draco.code(), ErrorCode::kUnsupported);
   EXPECT_NE(draco.message().find("draco: cannot encode an empty mesh"), std::string::npos)
       << draco.message();
@@ -368,8 +368,8 @@ TEST_F(ContourExport, DracoKeepsTrianglesWithARepeatedIndex) {
 
 TEST_F(ContourExport, SameMeshGivesTheSameBytes) {
   for (const char* name : {"same.obj", "same.ply", "same.stl", "same.glb", "same.drc"}) {
-    ASSERT_TRUE(save_contour_mesh(unit_cube(), temp_path(std::string("a_") + name)).ok());
-    ASSERT_TRUE(save_contour_mesh(unit_cube(), temp_path(std::string("b_") + name)).ok());
+    ASSERT_TRUE(save_mesh(unit_cube(), temp_path(std::string("a_") + name)).ok());
+    ASSERT_TRUE(save_mesh(unit_cube(), temp_path(std::string("b_") + name)).ok());
     EXPECT_EQ(read_bytes(temp_path(std::string("a_") + name)),
               read_bytes(temp_path(std::string("b_") + name)))
         << name;
@@ -380,13 +380,13 @@ TEST_F(ContourExport, SameMeshGivesTheSameBytes) {
 
 TEST_F(ContourExport, UnwritablePathGivesIoErrorAndLeavesNoFile) {
   const std::string missing_dir = temp_path("no-such-dir/mesh.obj");
-  const Status status = save_contour_mesh(unit_cube(), missing_dir);
+  const Status status = save_mesh(unit_cube(), missing_dir);
   EXPECT_EQ(status.code(), ErrorCode::kIoError);
   EXPECT_NE(status.message().find(missing_dir), std::string::npos) << status.message();
   // The rename fails when the target is a directory: the tmp file must go.
   const std::string directory = temp_path("is-a-directory.ply");
   fs::create_directories(directory);
-  const Status rename = save_contour_mesh(unit_cube(), directory);
+  const Status rename = save_mesh(unit_cube(), directory);
   EXPECT_EQ(rename.code(), ErrorCode::kIoError);
   EXPECT_NE(rename.message().find(directory), std::string::npos);
   EXPECT_FALSE(fs::exists(directory + ".tmp"));
@@ -395,7 +395,7 @@ TEST_F(ContourExport, UnwritablePathGivesIoErrorAndLeavesNoFile) {
 TEST_F(ContourExport, IndexOutOfRangeIsNamed) {
   ContourMesh mesh = unit_cube();
   mesh.triangles[5].y = 8;
-  const Status status = save_contour_mesh(mesh, temp_path("bad_index.obj"));
+  const Status status = save_mesh(mesh, temp_path("bad_index.obj"));
   EXPECT_EQ(status.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(status.message().find("triangle 5"), std::string::npos) << status.message();
   EXPECT_NE(status.message().find("index 8"), std::string::npos) << status.message();
@@ -405,7 +405,7 @@ TEST_F(ContourExport, IndexOutOfRangeIsNamed) {
 TEST_F(ContourExport, NanPositionIsNamed) {
   ContourMesh mesh = unit_cube();
   mesh.positions[6].z = std::numeric_limits<double>::quiet_NaN();
-  const Status status = save_contour_mesh(mesh, temp_path("bad_position.glb"));
+  const Status status = save_mesh(mesh, temp_path("bad_position.glb"));
   EXPECT_EQ(status.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(status.message().find("vertex 6"), std::string::npos) << status.message();
 }
@@ -413,16 +413,16 @@ TEST_F(ContourExport, NanPositionIsNamed) {
 TEST_F(ContourExport, WrongArraySizesAndOptionsAreNamed) {
   ContourMesh mesh = unit_cube();
   mesh.normals.pop_back();
-  const Status normals = save_contour_mesh(mesh, temp_path("bad_normals.ply"));
+  const Status normals = save_mesh(mesh, temp_path("bad_normals.ply"));
   EXPECT_EQ(normals.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(normals.message().find("normals"), std::string::npos) << normals.message();
   mesh = unit_cube();
   mesh.triangle_material.push_back(0);
-  EXPECT_NE(save_contour_mesh(mesh, temp_path("bad.ply")).message().find("triangle_material"),
+  EXPECT_NE(save_mesh(mesh, temp_path("bad.ply")).message().find("triangle_material"),
             std::string::npos);
   ExportOptions options;
   options.draco_position_bits = 40;
-  const Status bits = save_contour_mesh(unit_cube(), temp_path("bad.drc"), options);
+  const Status bits = save_mesh(unit_cube(), temp_path("bad.drc"), options);
   EXPECT_EQ(bits.code(), ErrorCode::kInvalidArgument);
   EXPECT_NE(bits.message().find("draco_position_bits"), std::string::npos);
 }

@@ -558,7 +558,9 @@ TEST(ChunkedMeshUpdate, ReportsExactlyTheChunkMeshesWhoseContentChanged) {
     EXPECT_FALSE(reported.empty());
     for (const ChunkMesh& m : meshes.chunks()) {
       const bool was_reported = std::find(reported.begin(), reported.end(), m.chunk) != reported.end();
-      if (!was_reported) EXPECT_LT(m.version, meshes.version());
+      if (!was_reported) {
+        EXPECT_LT(m.version, meshes.version());
+      }
     }
   }
 }

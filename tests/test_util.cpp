@@ -7,6 +7,8 @@
 #include <tuple>
 #include <vector>
 
+#include "meshio/meshio.h"
+
 namespace ldc::test {
 
 std::string data_path(const std::string& name) { return std::string(LDC_TEST_DATA_DIR) + "/" + name; }

@@ -8,6 +8,7 @@
 #include "common.h"
 #include "csg/csg.h"
 #include "mesh_output.h"
+#include "meshio/meshio.h"
 
 namespace ldc::tool {
 namespace {

@@ -8,6 +8,7 @@
 #include "common.h"
 #include "ldc/io.h"
 #include "ldc/terrain.h"
+#include "meshio/meshio.h"
 
 namespace ldc::tool {
 namespace {

@@ -4,6 +4,7 @@
 #include "common.h"
 #include "ldc/io.h"
 #include "mesh_output.h"
+#include "meshio/meshio.h"
 
 namespace ldc::tool {
 namespace {

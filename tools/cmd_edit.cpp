@@ -4,7 +4,7 @@
 
 #include "common.h"
 #include "contour/contour.h"
-#include "contour/export.h"
+#include "meshio/meshio.h"
 #include "edit_script.h"
 #include "ldc/io.h"
 #include "live/live.h"

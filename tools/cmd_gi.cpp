@@ -2,15 +2,11 @@
 // primary visibility by our ray cast, irradiance from the cascades (16
 // cones per pixel), albedo and emission from the materials; --reference
 // puts the path-traced image (Embree on the contoured mesh) beside it.
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <memory>
-#include <sstream>
 #include <vector>
-
-#include <stb_image_write.h>
 
 #include "camera.h"
 #include "common.h"
@@ -18,6 +14,7 @@
 #include "gi_bridge/gi.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
+#include "render/render.h"
 #ifdef LDC_HAVE_GI_REFERENCE
 #include "gi_bridge/path_trace.h"
 #endif
@@ -27,6 +24,7 @@ namespace {
 
 struct GiArgs {
   std::string world, output, engine = "vulkan";
+  std::string up = "auto";
   CameraArgs camera;
   int levels = 6, resolution = 32, passes = 3, bounces = 3, samples = 16;
   double voxel_size = 0.0;  // 0: 2 h
@@ -36,8 +34,9 @@ struct GiArgs {
   bool light_volume = false;
 };
 
-const char* const kGiHelp = R"(Sky: a gradient (zenith 1.0/1.2/1.6, horizon 1.4, ground 0.3) in the 16 lobes; emission
-from the materials. The cascades are centred on the camera; --passes lighting passes of
+const char* const kGiHelp = R"(Sky: a gradient (zenith 1.0/1.2/1.6, horizon 1.4, ground 0.3) in the 16 lobes, its
+zenith up (--up; z unless given: an .ldc world records no up axis); emission from the
+materials. The cascades are centred on the camera; --passes lighting passes of
 every level (3 give direct light and two bounces). --engine vulkan falls back to the CPU
 reference when no Vulkan device exists. Colour: albedo / pi * irradiance + emission,
 exposure, x / (1 + x), gamma 2.2. --reference path-traces the same view on the
@@ -48,9 +47,9 @@ them into a cascaded light volume as the talk does (less exact, see docs/gi.md).
 )";
 
 // The default sky and the --light point lights.
-Result<GiLights> parse_lights(const GiArgs& a) {
+Result<GiLights> parse_lights(const GiArgs& a, int up_axis) {
   GiLights l;
-  l.sky = SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f));
+  l.sky = SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f), up_axis);
   for (const std::string& text : a.lights) {
     std::vector<double> v;
     if (!parse_numbers(text, &v) || (v.size() != 4 && v.size() != 6))
@@ -62,12 +61,6 @@ Result<GiLights> parse_lights(const GiArgs& a) {
   config.light_volume = a.light_volume;
   if (Status s = check_gi_lights(l, config); !s.ok()) return s;
   return l;
-}
-
-uint8_t tone(float v, float exposure) {
-  v *= exposure;
-  v = v / (1.0f + v);
-  return uint8_t(std::lround(255.0f * std::pow(std::clamp(v, 0.0f, 1.0f), 1.0f / 2.2f)));
 }
 
 Result<std::unique_ptr<GiEngine>> make_engine(const std::string& name, const GiConfig& config, std::string* device) {
@@ -87,49 +80,17 @@ Result<std::unique_ptr<GiEngine>> make_engine(const std::string& name, const GiC
   return make_cpu_gi(config);
 }
 
-using Pixels = std::vector<glm::vec3>;
-
-// Cone-traced image: ray cast, then one irradiance query per hit.
-Status gi_image(const World& world, const Camera& cam, GiEngine& gi, const MaterialTable& mats, const GiLights& lights,
-                int bounces, Pixels& out) {
-  const size_t n = size_t(cam.width()) * size_t(cam.height());
-  std::vector<Ray> rays(n);
-  std::vector<RayHit> hits(n);
-  for (int y = 0; y < cam.height(); ++y)
-    for (int x = 0; x < cam.width(); ++x) rays[size_t(y) * size_t(cam.width()) + size_t(x)] = cam.pixel_ray(x, y);
-  Queries queries(world);
-  if (Status s = queries.ray_cast(rays, hits, nullptr); !s.ok()) return s;
-  std::vector<glm::dvec3> p;
-  std::vector<glm::vec3> nrm;
-  std::vector<size_t> pix;
-  out.assign(n, glm::vec3(0.0f));
-  for (size_t i = 0; i < n; ++i) {
-    if (!hits[i].hit || hits[i].started_inside) {
-      out[i] = hits[i].hit ? glm::vec3(0.0f) : lights.sky.radiance(glm::normalize(glm::vec3(rays[i].direction)));
-      continue;
-    }
-    p.push_back(hits[i].point);
-    nrm.push_back(hits[i].normal);
-    pix.push_back(i);
-  }
-  std::vector<glm::vec3> e(p.size());
-  if (Status s = gi.irradiance(p, nrm, bounces, e); !s.ok()) return s;
-  for (size_t k = 0; k < pix.size(); ++k) {
-    const VoxelMaterial& m = mats[hits[pix[k]].material];
-    out[pix[k]] = m.albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + m.emission;
-  }
-  return {};
-}
-
 #ifdef LDC_HAVE_GI_REFERENCE
-Status reference_image(const World& world, const Camera& cam, const MaterialTable& mats, const GiLights& lights,
-                       int bounces, int samples, Pixels& out) {
+// The same view path-traced on the contoured mesh (linear radiance).
+Result<RadianceImage> reference_image(const World& world, const Camera& cam, const MaterialTable& mats,
+                                      const GiLights& lights, int bounces, int samples) {
   Result<ContourMesh> mesh = contour_world(world);
   if (!mesh.ok()) return mesh.status();
   Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), mats, lights);
   if (!pt.ok()) return pt.status();
   const size_t n = size_t(cam.width()) * size_t(cam.height());
-  out.assign(n, glm::vec3(0.0f));
+  RadianceImage img{cam.width(), cam.height(), std::vector<glm::vec3>(n, glm::vec3(0.0f))};
+  std::vector<glm::vec3>& out = img.pixels;
   std::vector<glm::dvec3> p;
   std::vector<glm::vec3> nrm;
   std::vector<size_t> pix;
@@ -156,99 +117,124 @@ Status reference_image(const World& world, const Camera& cam, const MaterialTabl
   if (Status s = pt.value()->irradiance(p, nrm, bounces, e, pc); !s.ok()) return s;
   for (size_t k = 0; k < pix.size(); ++k)
     out[pix[k]] = mats[mat[k]].albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + mats[mat[k]].emission;
-  return {};
+  return img;
 }
 #endif
 
-int run_gi(const GiArgs& a, const CommonOptions& common) {
-  set_thread_count(common.threads);
-  if (Status s = check_camera_args(a.camera); !s.ok()) return fail("gi", s);
-  if (a.passes < 1 || a.passes > 16) return fail("gi", "--passes " + std::to_string(a.passes) + ": must be 1 .. 16");
-  if (a.bounces < 1 || a.bounces > 3) return fail("gi", "--bounces " + std::to_string(a.bounces) + ": must be 1 .. 3");
+// What the lighting and image took, for the report.
+struct GiRun {
+  std::string device;
+  CascadeConfig cascades;
+  GiTimings lighting;
+  double voxelize_seconds = 0.0, image_seconds = 0.0, reference_seconds = 0.0;
+  int width = 0, height = 0, up_axis = kLdcUpAxis;
+};
+
+void print_report(const GiArgs& a, const GiLights& lights, const GiRun& r, bool json) {
+  const size_t surface_voxels = r.lighting.surface_voxels / size_t(a.passes);
+  if (json) {
+    nlohmann::json j{{"device", r.device},
+                     {"levels", a.levels},
+                     {"resolution", a.resolution},
+                     {"voxel_size", r.cascades.voxel_size},
+                     {"surface_voxels", surface_voxels},
+                     {"passes", a.passes},
+                     {"up", axis_name(r.up_axis)},
+                     {"point_lights", {{"count", lights.points.size()}, {"mode", a.light_volume ? "injected volume" : "exact"}}},
+                     {"seconds", {{"voxelize", r.voxelize_seconds}, {"lighting", r.lighting.seconds}, {"lighting_device", r.lighting.device_seconds}, {"image", r.image_seconds}}},
+                     {"image", {{"width", r.width}, {"height", r.height}, {"bounces", a.bounces}}},
+                     {"output", a.output}};
+    if (a.reference) {
+      j["reference"] = {{"samples", a.samples}};
+      j["seconds"]["reference"] = r.reference_seconds;
+    }
+    std::printf("%s\n", j.dump(2).c_str());
+    return;
+  }
+  std::printf("gi: %s, %d levels of %d^3 voxels of %.3g m, %zu surface voxels; voxelize %.3f s\n", r.device.c_str(),
+              a.levels, a.resolution, r.cascades.voxel_size, surface_voxels, r.voxelize_seconds);
+  char device_time[64] = "";  // GPU timestamps (or the CPU engine's kernels); none without timestamps
+  if (r.lighting.device_seconds >= 0)
+    std::snprintf(device_time, sizeof(device_time), " (device %.3f s each)", r.lighting.device_seconds / a.passes);
+  std::printf("gi: %d lighting passes %.3f s (%.3f s each)%s, image %d x %d (%d bounces) %.3f s\n", a.passes,
+              r.lighting.seconds, r.lighting.seconds / a.passes, device_time, r.width, r.height, a.bounces,
+              r.image_seconds);
+  if (a.reference)
+    std::printf("gi: path-traced reference, %d paths per pixel, %.3f s (right half)\n", a.samples, r.reference_seconds);
+  std::printf("wrote %s\n", a.output.c_str());
+}
+
+// Checks what needs no world, so that it fails before the world loads.
+Status check_args(const GiArgs& a) {
+  if (Status s = check_camera_args(a.camera); !s.ok()) return s;
+  if (a.passes < 1 || a.passes > 16)
+    return Status(ErrorCode::kInvalidArgument, "--passes " + std::to_string(a.passes) + ": must be 1 .. 16");
+  if (a.bounces < 1 || a.bounces > 3)
+    return Status(ErrorCode::kInvalidArgument, "--bounces " + std::to_string(a.bounces) + ": must be 1 .. 3");
 #ifndef LDC_HAVE_GI_REFERENCE
-  if (a.reference) return fail("gi", "--reference: built without Embree 3 (the path tracer's ray caster)");
+  if (a.reference)
+    return Status(ErrorCode::kUnsupported, "--reference: built without Embree 3 (the path tracer's ray caster)");
 #endif
-  Result<GiLights> parsed_lights = parse_lights(a);
-  if (!parsed_lights.ok()) return fail("gi", parsed_lights.status());
-  const GiLights& lights = parsed_lights.value();
+  return parse_up_axis(a.up, kLdcUpAxis).status();
+}
+
+// Voxelizes around the camera, lights the cascades and renders the image
+// (with the reference on the right).
+Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, const GiLights& lights, GiRun& r) {
+  r.cascades.levels = a.levels;
+  r.cascades.resolution = a.resolution;
+  r.cascades.voxel_size = a.voxel_size > 0.0 ? a.voxel_size : 2.0 * world.lattice().cell_size;
+  ScopedTimer t_vox(nullptr, "");
+  Result<Cascades> cas = Cascades::create(world.lattice(), r.cascades);
+  if (!cas.ok()) return cas.status();
+  if (Status s = cas.value().update_all(world, cam.position()); !s.ok()) return s;
+  r.voxelize_seconds = t_vox.seconds();
   GiConfig gi_config;
   gi_config.light_volume = a.light_volume;
+  Result<std::unique_ptr<GiEngine>> gi = make_engine(a.engine, gi_config, &r.device);
+  if (!gi.ok()) return gi.status();
+  if (Status s = gi.value()->load(cas.value(), lights); !s.ok()) return s;
+  Result<GiTimings> upd = gi.value()->update_all(a.passes);
+  if (!upd.ok()) return upd.status();
+  r.lighting = upd.value();
+  ScopedTimer t_img(nullptr, "");
+  Queries queries(world);
+  Result<RadianceImage> lit = render_gi(queries, cam, *gi.value(), r.cascades.materials, lights.sky, a.bounces);
+  if (!lit.ok()) return lit.status();
+  r.image_seconds = t_img.seconds();
+  Image image = tone_map(lit.value(), a.exposure);
+#ifdef LDC_HAVE_GI_REFERENCE
+  if (a.reference) {
+    ScopedTimer t_ref(nullptr, "");
+    Result<RadianceImage> ref = reference_image(world, cam, r.cascades.materials, lights, a.bounces, a.samples);
+    if (!ref.ok()) return ref.status();
+    r.reference_seconds = t_ref.seconds();
+    return side_by_side(image, tone_map(ref.value(), a.exposure));
+  }
+#endif
+  return image;
+}
+
+int run_gi(const GiArgs& a, const CommonOptions& common) {
+  set_thread_count(common.threads);
+  if (Status s = check_args(a); !s.ok()) return fail("gi", s);
+  const int up_axis = parse_up_axis(a.up, kLdcUpAxis).value();
+  Result<GiLights> lights = parse_lights(a, up_axis);
+  if (!lights.ok()) return fail("gi", lights.status());
   ProgressBar bar(!common.quiet);
   Result<World> w = load_world(a.world, {}, bar.context());
   bar.finish();
   if (!w.ok()) return fail("gi", w.status());
-  const World& world = w.value();
-  Result<Camera> cam = Camera::make(a.camera, &world);
+  Result<Camera> cam = make_camera(a.camera, up_axis, &w.value());
   if (!cam.ok()) return fail("gi", cam.status());
-  CascadeConfig cc;
-  cc.levels = a.levels;
-  cc.resolution = a.resolution;
-  cc.voxel_size = a.voxel_size > 0.0 ? a.voxel_size : 2.0 * world.lattice().cell_size;
-  ScopedTimer t_vox(nullptr, "");
-  Result<Cascades> cas = Cascades::create(world.lattice(), cc);
-  if (!cas.ok()) return fail("gi", cas.status());
-  if (Status s = cas.value().update_all(world, cam.value().position()); !s.ok()) return fail("gi", s);
-  const double vox_s = t_vox.seconds();
-  std::string device;
-  Result<std::unique_ptr<GiEngine>> gi = make_engine(a.engine, gi_config, &device);
-  if (!gi.ok()) return fail("gi", gi.status());
-  if (Status s = gi.value()->load(cas.value(), lights); !s.ok()) return fail("gi", s);
-  Result<GiTimings> upd = gi.value()->update_all(a.passes);
-  if (!upd.ok()) return fail("gi", upd.status());
-  ScopedTimer t_img(nullptr, "");
-  Pixels lit;
-  if (Status s = gi_image(world, cam.value(), *gi.value(), cc.materials, lights, a.bounces, lit); !s.ok())
-    return fail("gi", s);
-  const double img_s = t_img.seconds();
-  Pixels ref;
-  double ref_s = 0.0;
-#ifdef LDC_HAVE_GI_REFERENCE
-  if (a.reference) {
-    ScopedTimer t_ref(nullptr, "");
-    if (Status s = reference_image(world, cam.value(), cc.materials, lights, a.bounces, a.samples, ref); !s.ok())
-      return fail("gi", s);
-    ref_s = t_ref.seconds();
-  }
-#endif
-  const int wdt = cam.value().width(), hgt = cam.value().height(), cols = a.reference ? 2 : 1;
-  std::vector<uint8_t> rgb(size_t(wdt * cols) * size_t(hgt) * 3);
-  for (int y = 0; y < hgt; ++y) {
-    for (int x = 0; x < wdt * cols; ++x) {
-      const glm::vec3 c =
-          x < wdt ? lit[size_t(y) * size_t(wdt) + size_t(x)] : ref[size_t(y) * size_t(wdt) + size_t(x - wdt)];
-      uint8_t* o = &rgb[3 * (size_t(y) * size_t(wdt * cols) + size_t(x))];
-      for (int k = 0; k < 3; ++k) o[k] = tone(c[k], a.exposure);
-    }
-  }
-  if (!stbi_write_png(a.output.c_str(), wdt * cols, hgt, 3, rgb.data(), wdt * cols * 3))
-    return fail("gi", "-o " + a.output + ": cannot write the PNG");
-  if (common.json) {
-    nlohmann::json j{{"device", device},
-                     {"levels", a.levels},
-                     {"resolution", a.resolution},
-                     {"voxel_size", cc.voxel_size},
-                     {"surface_voxels", upd.value().surface_voxels / size_t(a.passes)},
-                     {"passes", a.passes},
-                     {"point_lights", {{"count", lights.points.size()}, {"mode", a.light_volume ? "injected volume" : "exact"}}},
-                     {"seconds", {{"voxelize", vox_s}, {"lighting", upd.value().seconds}, {"lighting_device", upd.value().device_seconds}, {"image", img_s}}},
-                     {"image", {{"width", wdt}, {"height", hgt}, {"bounces", a.bounces}}},
-                     {"output", a.output}};
-    if (a.reference) {
-      j["reference"] = {{"samples", a.samples}};
-      j["seconds"]["reference"] = ref_s;
-    }
-    std::printf("%s\n", j.dump(2).c_str());
-    return 0;
-  }
-  std::printf("gi: %s, %d levels of %d^3 voxels of %.3g m, %zu surface voxels; voxelize %.3f s\n", device.c_str(),
-              a.levels, a.resolution, cc.voxel_size, upd.value().surface_voxels / size_t(a.passes), vox_s);
-  char device_time[64] = "";  // GPU timestamps (or the CPU engine's kernels); none without timestamps
-  if (upd.value().device_seconds >= 0)
-    std::snprintf(device_time, sizeof(device_time), " (device %.3f s each)", upd.value().device_seconds / a.passes);
-  std::printf("gi: %d lighting passes %.3f s (%.3f s each)%s, image %d x %d (%d bounces) %.3f s\n", a.passes,
-              upd.value().seconds, upd.value().seconds / a.passes, device_time, wdt, hgt, a.bounces, img_s);
-  if (a.reference) std::printf("gi: path-traced reference, %d paths per pixel, %.3f s (right half)\n", a.samples, ref_s);
-  std::printf("wrote %s\n", a.output.c_str());
+  GiRun run;
+  run.up_axis = up_axis;
+  run.width = cam.value().width();
+  run.height = cam.value().height();
+  Result<Image> image = lit_image(a, w.value(), cam.value(), lights.value(), run);
+  if (!image.ok()) return fail("gi", image.status());
+  if (Status s = write_png(image.value(), a.output); !s.ok()) return fail("gi", "-o " + s.message());
+  print_report(a, lights.value(), run, common.json);
   return 0;
 }
 
@@ -260,6 +246,7 @@ void add_gi_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("world", args->world, ".ldc file")->required();
   cmd->add_option("-o,--output", args->output, "Output .png")->required();
   add_camera_options(cmd, args->camera, " (default: a view of the whole solid)");
+  add_up_option(cmd, args->up, "z (an .ldc world records no up axis)");
   cmd->add_option("--engine", args->engine, "vulkan or cpu")->capture_default_str();
   cmd->add_option("--levels", args->levels, "Cascade levels")->capture_default_str();
   cmd->add_option("--resolution", args->resolution, "Voxels per axis and level")->capture_default_str();

@@ -4,14 +4,16 @@
 
 #include "common.h"
 #include "ldc/io.h"
+#include "meshio/meshio.h"
 #include "nav/nav.h"
 
 namespace ldc::tool {
 namespace {
 
 const char* const kPathHelp = R"(The input is an .ldc world, or a mesh level (OBJ, PLY, STL, OFF) that is first
-built into an LDC at the navigation cell size (--cell-size). The up axis defaults to z for
-.ldc worlds (the built-in landscape is z up) and to y for meshes (the Recast convention).
+built into an LDC at the navigation cell size (--cell-size). The up axis (--up) defaults to z
+for .ldc worlds (the built-in landscape is z up; a world records no up axis) and to y for
+meshes (the Recast convention).
 Output (stdout, or -o FILE), drawable with `ldc render --overlay FILE`:
   {"status": "complete" | "unreachable" | "out_of_nodes", "length": metres,
    "path": [[x,y,z], ...], "start": [x,y,z] (the start snapped to its floor), "end": [x,y,z]
@@ -34,14 +36,6 @@ struct PathArgs {
   int max_nodes = 2048;  // NavQuery's default budget (nav/nav.h)
   NavConfig agent;
 };
-
-Result<int> up_axis(const PathArgs& a) {
-  if (a.up == "auto") return has_ldc_extension(a.input) ? 2 : 1;
-  if (a.up == "x") return 0;
-  if (a.up == "y") return 1;
-  if (a.up == "z") return 2;
-  return Status(ErrorCode::kInvalidArgument, "--up " + a.up + ": expected x, y, z or auto");
-}
 
 Result<World> load_input(const PathArgs& a, Context* ctx) {
   if (has_ldc_extension(a.input)) return load_world(a.input, {}, ctx);
@@ -90,7 +84,8 @@ int run_path(PathArgs a, const CommonOptions& common) {
   glm::dvec3 from, to;
   if (!parse_vec3(a.from, &from)) return fail("path", "--from " + a.from + ": expected x,y,z");
   if (!parse_vec3(a.to, &to)) return fail("path", "--to " + a.to + ": expected x,y,z");
-  Result<int> up = up_axis(a);
+  // A mesh level follows the Recast convention (y up); an .ldc world records none (z).
+  Result<int> up = parse_up_axis(a.up, has_ldc_extension(a.input) ? kLdcUpAxis : 1);
   if (!up.ok()) return fail("path", up.status());
   a.agent.up_axis = up.value();
   ProgressBar bar(!common.quiet);
@@ -115,12 +110,7 @@ int run_path(PathArgs a, const CommonOptions& common) {
     if (!common.json) print_summary(stderr, out);
     return 0;
   }
-  std::FILE* f = std::fopen(a.output.c_str(), "wb");
-  if (!f) return fail("path", "-o " + a.output + ": cannot open for writing");
-  const std::string text = out.dump(2) + "\n";
-  bool ok = std::fwrite(text.data(), 1, text.size(), f) == text.size();
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok) return fail("path", "-o " + a.output + ": write failed");
+  if (Status s = write_file_atomically(a.output, out.dump(2) + "\n"); !s.ok()) return fail("path", s);
   if (common.json) {
     std::printf("%s\n", nlohmann::json{{"ok", true}, {"output", a.output}, {"status", out["status"]},
                                        {"length", out["length"]}}.dump(2).c_str());
@@ -139,7 +129,7 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("input", args->input, ".ldc world or mesh level")->required();
   cmd->add_option("--from", args->from, "Start x,y,z (m); snapped to the nearest walkable floor")->required();
   cmd->add_option("--to", args->to, "Goal x,y,z (m)")->required();
-  cmd->add_option("--up", args->up, "Up axis: x, y, z or auto")->capture_default_str();
+  add_up_option(cmd, args->up, "z for an .ldc world (it records no up axis), y for a mesh");
   cmd->add_option("--cell-size", args->cell_size, "Navigation cell for mesh input (m)")->capture_default_str();
   cmd->add_option("--agent-height", args->agent.agent_height, "Free height the agent needs (m)")->capture_default_str();
   cmd->add_option("--agent-radius", args->agent.agent_radius, "Agent radius: erosion from walls and drops (m)")->capture_default_str();

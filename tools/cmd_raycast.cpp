@@ -174,7 +174,7 @@ Result<RaySource> make_rays(const RaycastArgs& a, const World& world) {
     src.name = "ray";
     return src;
   }
-  Result<Camera> cam = Camera::make(a.camera, &world);
+  Result<Camera> cam = make_camera(a.camera, kLdcUpAxis, &world);
   if (!cam.ok()) return cam.status();
   const Camera& c = cam.value();
   if (size_t(c.width()) * size_t(c.height()) > kMaxCameraRays) {

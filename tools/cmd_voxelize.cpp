@@ -15,7 +15,8 @@ namespace {
 
 const char* const kVoxelizeHelp = R"(Without --cascades: one dense grid over the world's solid at --voxel-size (a whole
 number of cells h). With --cascades K: K camera-centred levels of N^3 voxels (--resolution, default 32), level k of
-voxel size s * 2^k, around --camera (default: the centre of the solid).
+voxel size s * 2^k, around --camera (default: the centre of the solid). Voxels have no up; --up sets the
+default ray family (--ray-axis): the vertical rays, so that a y-up level gives the voxels of its z-up twin.
 Output by extension: .vdb (OpenVDB grids occupancy, normal, albedo; per cascade level _L<k>), or .json / .raw
 (both files are written: little-endian arrays in .raw, their names, types, shapes and offsets in .json).)";
 
@@ -26,7 +27,8 @@ struct VoxelizeArgs {
   int cascades = 0;
   int resolution = 32;
   std::string camera;
-  std::string axis = "z";
+  std::string up = "auto";
+  std::string axis;  // empty: the up axis
   bool occupancy_only = false;
 };
 
@@ -38,11 +40,13 @@ Result<Format> output_format(const std::string& path) {
   return Status(ErrorCode::kInvalidArgument, "-o " + path + ": unknown output format (use .vdb, .json or .raw)");
 }
 
-Result<int> parse_axis(const std::string& a) {
-  if (a == "x") return 0;
-  if (a == "y") return 1;
-  if (a == "z") return 2;
-  return Status(ErrorCode::kInvalidArgument, "--ray-axis '" + a + "': use x, y or z");
+// The ray family: --ray-axis, or the up axis (the library's default, z, is
+// the vertical of a z-up world: a y-up level then voxelizes as its z-up twin).
+Result<int> ray_axis(const VoxelizeArgs& a) {
+  Result<int> up = parse_up_axis(a.up, kLdcUpAxis);
+  if (!up.ok() || a.axis.empty()) return up;
+  if (a.axis == "x" || a.axis == "y" || a.axis == "z") return a.axis[0] - 'x';
+  return Status(ErrorCode::kInvalidArgument, "--ray-axis '" + a.axis + "': use x, y or z");
 }
 
 nlohmann::json box_json(const VoxelBox& b) {
@@ -130,7 +134,7 @@ int run_voxelize(const VoxelizeArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
   Result<Format> format = output_format(a.output);
   if (!format.ok()) return fail("voxelize", format.status());
-  Result<int> axis = parse_axis(a.axis);
+  Result<int> axis = ray_axis(a);
   if (!axis.ok()) return fail("voxelize", axis.status());
   if (a.cascades < 0) return fail("voxelize", "--cascades " + std::to_string(a.cascades) + ": must be >= 0 (0: one dense grid)");
   if (a.cascades == 0 && !a.camera.empty()) return fail("voxelize", "--camera needs --cascades K");
@@ -145,6 +149,7 @@ int run_voxelize(const VoxelizeArgs& a, const CommonOptions& common) {
   j.value()["input"] = a.world;
   j.value()["output"] = a.output;
   j.value()["threads"] = thread_count();
+  j.value()["ray_axis"] = axis_name(axis.value());
   if (common.json) {
     std::printf("%s\n", j.value().dump(2).c_str());
   } else {
@@ -165,7 +170,8 @@ void add_voxelize_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--cascades", args->cascades, "Camera-centred cascade levels K (0 = one dense grid)");
   cmd->add_option("--resolution", args->resolution, "Voxels per axis of each cascade level")->capture_default_str();
   cmd->add_option("--camera", args->camera, "Cascade centre x,y,z (m); default: the centre of the solid");
-  cmd->add_option("--ray-axis,--axis", args->axis, "Ray family integrated for the occupancy: x, y or z")->capture_default_str();
+  add_up_option(cmd, args->up, "z (an .ldc world records no up axis)");
+  cmd->add_option("--ray-axis,--axis", args->axis, "Ray family integrated for the occupancy: x, y or z (default: the up axis)");
   cmd->add_flag("--occupancy-only", args->occupancy_only, "Dense grid: occupancy only, no normal/albedo (faster)");
   cmd->callback([args, &common] {
     int code = run_voxelize(*args, common);

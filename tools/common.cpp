@@ -179,6 +179,18 @@ bool has_ldc_extension(const std::string& path) {
   return ext == ".ldc";
 }
 
+void add_up_option(CLI::App* cmd, std::string& up, const std::string& auto_means) {
+  cmd->add_option("--up", up, "Up axis: x, y or z; auto: " + auto_means)->capture_default_str();
+}
+
+Result<int> parse_up_axis(const std::string& text, int auto_axis) {
+  if (text == "auto") return auto_axis;
+  if (text == "x" || text == "y" || text == "z") return text[0] - 'x';
+  return Status(ErrorCode::kInvalidArgument, "--up '" + text + "': use x, y, z or auto");
+}
+
+std::string axis_name(int axis) { return std::string(1, char('x' + axis)); }
+
 nlohmann::json vec_json(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
 
 }  // namespace ldc::tool

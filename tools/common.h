@@ -54,6 +54,17 @@ Result<nlohmann::json> read_json_file(const std::string& path);
 // Whether a path ends in .ldc (any case).
 bool has_ldc_extension(const std::string& path);
 
+// --up, the world's up axis, shared by render, gi, voxelize and path: x, y or
+// z; "auto" (the default) is the input's convention, `auto_means` in the help.
+// An .ldc world records no up axis (no command writes one in its metadata):
+// for it, auto is z (kLdcUpAxis).
+inline constexpr int kLdcUpAxis = 2;
+void add_up_option(CLI::App* cmd, std::string& up, const std::string& auto_means);
+// "x" 0, "y" 1, "z" 2, "auto" `auto_axis`; anything else is refused, naming it.
+Result<int> parse_up_axis(const std::string& text, int auto_axis);
+// "x", "y" or "z" for an axis 0, 1 or 2 (JSON output).
+std::string axis_name(int axis);
+
 // [x, y, z] for JSON output.
 nlohmann::json vec_json(const glm::dvec3& v);
 

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
+#include "meshio/meshio.h"
 
 namespace ldc::tool {
 

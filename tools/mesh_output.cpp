@@ -2,7 +2,7 @@
 
 #include <cstdio>
 
-#include "contour/export.h"
+#include "meshio/meshio.h"
 
 namespace ldc::tool {
 namespace {
@@ -98,7 +98,7 @@ int write_and_report(const std::string& command, const World& w, const ContourMe
                      const std::string& output, ProgressBar& bar, nlohmann::json report, const CommonOptions& common,
                      const ExtraReportLines& extra_lines) {
   ScopedTimer e(nullptr, "");
-  Status s = save_contour_mesh(mesh, output, export_options(w));
+  Status s = save_mesh(mesh, output, export_options(w));
   report["seconds"]["export"] = e.seconds();
   bar.finish();
   if (!s.ok()) return fail(command, s);

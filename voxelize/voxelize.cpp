@@ -12,6 +12,7 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
+#include "ldc/materials.h"
 #include "ldc/terrain.h"
 #include "voxelize/detail/block.h"
 #include "voxelize/detail/objects.h"
@@ -42,11 +43,8 @@ Status check_channel(const glm::vec3& v, double max, const std::string& what) {
 
 MaterialTable default_material_table() {
   MaterialTable t;
-  t.materials.resize(4);
-  t.materials[kMaterialRock].albedo = {0.42f, 0.40f, 0.38f};
-  t.materials[kMaterialGrass].albedo = {0.22f, 0.45f, 0.14f};
-  t.materials[kMaterialDirt].albedo = {0.40f, 0.28f, 0.17f};
-  t.materials[kMaterialSand].albedo = {0.76f, 0.69f, 0.50f};
+  t.materials.resize(kPaletteSize);
+  for (int id = 0; id < kPaletteSize; ++id) t.materials[size_t(id)].albedo = material_albedo(uint16_t(id));
   t.fallback.albedo = glm::vec3(0.5f);
   return t;
 }

@@ -113,7 +113,9 @@ struct MaterialTable {
     return id < materials.size() ? materials[id] : fallback;
   }
 };
-// The landscape's materials (ldc/terrain.h): rock, grass, dirt, sand.
+// The one palette's albedos (ldc/materials.h, material_albedo) for ids
+// 0 .. kPaletteSize - 1, the landscape's first (ldc/terrain.h: rock, grass,
+// dirt, sand); later ids take the fallback, 0.5 grey.
 MaterialTable default_material_table();
 // Checks every channel's range; the error names the material id and field.
 Status check_material_table(const MaterialTable& table);

@@ -15,11 +15,11 @@
 //               and a fan of 32 rays looks ahead of the player (Queries);
 //               LiveWorld::update_queries then frees what edits replaced.
 // It prints each frame's times as a markdown table, then the median, p95
-// and max of each column. With --png DIR it saves a few frames as .ldc
-// files and renders them through the ldc tool (`ldc render`) with the
-// agent's path and the two characters drawn on top.
+// and max of each column. With --png DIR it renders a few frames in
+// process (render/render.h, the renderer of `ldc render`) with the agent's
+// path and the two characters drawn on top, and writes them as PNGs.
 //
-// Usage: game_loop [--frames N] [--png DIR] [--ldc PATH-TO-ldc-TOOL] [--quiet]
+// Usage: game_loop [--frames N] [--png DIR] [--quiet]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -27,7 +27,6 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <optional>
 #include <string>
 #include <vector>
@@ -35,6 +34,7 @@
 #include "ldc/io.h"
 #include "ldc/terrain.h"
 #include "live/live.h"
+#include "render/render.h"
 
 namespace {
 
@@ -47,12 +47,6 @@ double ms_since(Clock::time_point start) {
 struct Options {
   int frames = 60;
   std::string png_dir;
-  std::string ldc_tool =
-#ifdef LDC_TOOL_PATH
-      LDC_TOOL_PATH;
-#else
-      "ldc";
-#endif
   bool quiet = false;
 };
 
@@ -68,12 +62,10 @@ bool parse_options(int argc, char** argv, Options* o) {
       }
     } else if (a == "--png" && has_value) {
       o->png_dir = argv[++i];
-    } else if (a == "--ldc" && has_value) {
-      o->ldc_tool = argv[++i];
     } else if (a == "--quiet") {
       o->quiet = true;
     } else {
-      std::fprintf(stderr, "usage: game_loop [--frames N] [--png DIR] [--ldc PATH] [--quiet]\n");
+      std::fprintf(stderr, "usage: game_loop [--frames N] [--png DIR] [--quiet]\n");
       return false;
     }
   }
@@ -236,34 +228,28 @@ void print_table(const std::vector<Frame>& frames, bool rows) {
   }
 }
 
-// Saves the world and an overlay (the agent's path; player and agent as
-// points) and renders them with `ldc render`.
+// Renders the live world with an overlay (the agent's path; player and
+// agent as points) and writes it to DIR/frame_NNN.png.
 bool render_frame(const Session& s, const Options& o, int frame) {
-  namespace fs = std::filesystem;
-  const fs::path dir(o.png_dir);
-  char stem[32];
-  std::snprintf(stem, sizeof stem, "frame_%03d", frame);
-  const std::string ldc_path = (dir / (std::string(stem) + ".ldc")).string();
-  const std::string overlay_path = (dir / (std::string(stem) + ".json")).string();
-  const std::string png_path = (dir / (std::string(stem) + ".png")).string();
-  if (ldc::Status st = ldc::save_world(s.live.world(), ldc_path); !st.ok()) {
-    std::fprintf(stderr, "%s\n", st.to_string().c_str());
-    return false;
-  }
-  std::ofstream overlay(overlay_path);
-  overlay << "{\"path\": [";
-  for (size_t i = 0; i < s.agent_path.size(); ++i) {
-    const glm::dvec3& c = s.agent_path[i];
-    overlay << (i ? ", " : "") << "[" << c.x << ", " << c.y << ", " << c.z + 0.2 << "]";
-  }
-  overlay << "], \"points\": [[" << s.player.x << ", " << s.player.y << ", " << s.player.z + 0.5 << "], ["
-          << s.agent.x << ", " << s.agent.y << ", " << s.agent.z + 0.5 << "]]}\n";
-  overlay.close();
-  const std::string cmd = "\"" + o.ldc_tool + "\" -q render \"" + ldc_path + "\" -o \"" + png_path +
-                          "\" --camera 24,6,40 --target 24,26,3 --fov 60 --width 640 --height 360 --shadows" +
-                          " --overlay \"" + overlay_path + "\" > /dev/null";
-  if (std::system(cmd.c_str()) != 0) {
-    std::fprintf(stderr, "render failed: %s\n", cmd.c_str());
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%03d.png", frame);
+  const std::string png_path = (std::filesystem::path(o.png_dir) / name).string();
+  ldc::CameraConfig view;
+  view.position = glm::dvec3(24, 6, 40);
+  view.target = glm::dvec3(24, 26, 3);
+  view.fov_degrees = 60.0;
+  view.width = 640;
+  view.height = 360;
+  ldc::RenderOptions options;
+  options.shadows = true;
+  std::vector<glm::dvec3>& path = options.overlay.paths.emplace_back();
+  for (const glm::dvec3& c : s.agent_path) path.push_back(c + glm::dvec3(0.0, 0.0, 0.2));
+  options.overlay.points = {s.player + glm::dvec3(0.0, 0.0, 0.5), s.agent + glm::dvec3(0.0, 0.0, 0.5)};
+  ldc::Result<ldc::Camera> camera = ldc::Camera::make(view);
+  ldc::Result<ldc::Image> image = camera.ok() ? ldc::render(s.live.queries(), *camera, options) : camera.status();
+  const ldc::Status st = image.ok() ? ldc::write_png(*image, png_path) : image.status();
+  if (!st.ok()) {
+    std::fprintf(stderr, "render failed: %s\n", st.to_string().c_str());
     return false;
   }
   std::printf("wrote %s\n", png_path.c_str());

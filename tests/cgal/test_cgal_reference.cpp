@@ -113,7 +113,7 @@ TEST(CgalReference, OpenBunnyVolumeWithinTwoPercentOfTheHoleFilledBunny) {
 #include <CGAL/Polygon_mesh_processing/self_intersections.h>
 
 #include "contour/contour.h"
-#include "contour/export.h"
+#include "meshio/meshio.h"
 
 namespace ldc {
 namespace {

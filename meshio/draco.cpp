@@ -22,9 +22,9 @@
 #include <cstring>
 #include <unordered_map>
 
-#include "contour/detail/export.h"
+#include "meshio/detail/codecs.h"
 
-namespace ldc::export_detail {
+namespace ldc::meshio_detail {
 namespace {
 
 constexpr const char* kMaterialName = "_MATERIAL";
@@ -251,4 +251,4 @@ Result<ContourMesh> decode_draco(std::string_view bytes, const std::string& path
   return DracoReader(*mesh, path).read();
 }
 
-}  // namespace ldc::export_detail
+}  // namespace ldc::meshio_detail

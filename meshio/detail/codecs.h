@@ -1,5 +1,5 @@
-// Internals of the exporters: export.cpp (dispatch, checks, OBJ, PLY, STL,
-// file I/O) shares these with export_gltf.cpp and export_draco.cpp, kept
+// Internals of meshio: meshio.cpp (dispatch, checks, OBJ, PLY, STL, OFF)
+// shares these with gltf.cpp and draco.cpp, kept
 // apart so that tinygltf's and Draco's heavy headers are compiled once, in
 // the file that needs them.
 #pragma once
@@ -9,9 +9,9 @@
 #include <string_view>
 #include <vector>
 
-#include "contour/export.h"
+#include "meshio/meshio.h"
 
-namespace ldc::export_detail {
+namespace ldc::meshio_detail {
 
 // triangle_material[t], or 0 when the mesh has no materials.
 inline uint16_t material_of(const ContourMesh& mesh, size_t triangle) {
@@ -41,14 +41,14 @@ void complete_loaded_mesh(ContourMesh& mesh);
 // "path: message" with the given code.
 Status error_at(ErrorCode code, std::string_view path, std::string_view message);
 
-// glTF 2.0 binary (export_gltf.cpp).
+// glTF 2.0 binary (gltf.cpp).
 Result<std::string> encode_glb(const ContourMesh& mesh, const ExportOptions& options,
                                const std::string& path);
 Result<ContourMesh> decode_glb(std::string_view bytes, const std::string& path);
 
-// Draco (export_draco.cpp).
+// Draco (draco.cpp).
 Result<std::string> encode_draco(const ContourMesh& mesh, const ExportOptions& options,
                                  const std::string& path);
 Result<ContourMesh> decode_draco(std::string_view bytes, const std::string& path);
 
-}  // namespace ldc::export_detail
+}  // namespace ldc::meshio_detail

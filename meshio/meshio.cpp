@@ -1,11 +1,12 @@
-// Writing contoured meshes as OBJ, PLY and STL (glTF and Draco live in
-// export_gltf.cpp and export_draco.cpp), the atomic file write every format
-// shares, and reading the files back.
+// meshio: dispatch by format, the checks every writer shares, OBJ, PLY, STL
+// and OFF writing, and reading every format back (the text and binary
+// parsers are in parse.cpp, glTF in gltf.cpp, Draco in draco.cpp).
 //
-// Every encoder builds the whole file in memory and hands it to one fwrite.
-// OBJ text is formatted with std::to_chars straight into buffers, in blocks
-// on all cores, which keeps a million-triangle OBJ well under a second.
-#include "contour/export.h"
+// Every encoder builds the whole file in memory and hands it to one atomic
+// write (ldc/io.h). OBJ text is formatted with std::to_chars straight into
+// buffers, in blocks on all cores, which keeps a million-triangle OBJ well
+// under a second.
+#include "meshio/meshio.h"
 
 #include <tbb/parallel_for.h>
 
@@ -25,11 +26,12 @@
 #include <unordered_map>
 #include <utility>
 
-#include "contour/detail/export.h"
 #include "internal/vec_text.h"
+#include "ldc/io.h"
+#include "meshio/detail/codecs.h"
 
 namespace ldc {
-namespace export_detail {
+namespace meshio_detail {
 
 Status error_at(ErrorCode code, std::string_view path, std::string_view message) {
   std::string text(path);
@@ -141,9 +143,9 @@ void complete_loaded_mesh(ContourMesh& mesh) {
   }
 }
 
-}  // namespace export_detail
+}  // namespace meshio_detail
 
-using namespace export_detail;
+using namespace meshio_detail;
 
 namespace {
 
@@ -309,19 +311,40 @@ void append_obj_header(TextBuffer& out, const MaterialGroups& groups,
   }
 }
 
-// Formats items [0, count) in blocks on all cores and appends the blocks in
-// order, so the bytes are the same whatever the thread count.
-template <class Format>
-void append_in_parallel(TextBuffer& out, size_t count, size_t bytes_per_item, Format format) {
-  constexpr size_t kBlock = 16384;
-  std::vector<std::string> blocks((count + kBlock - 1) / kBlock);
-  tbb::parallel_for(size_t{0}, blocks.size(), [&](size_t b) {
-    TextBuffer part(kBlock * bytes_per_item);
-    for (size_t i = b * kBlock; i < std::min(count, (b + 1) * kBlock); ++i) format(part, i);
-    blocks[b] = std::move(part).take();
-  });
-  for (const std::string& block : blocks) out.put(block);
-}
+// A text file as pieces formatted in parallel and joined once at the end:
+// one allocation of the exact size, no zero-filling and no regrowth.
+class TextPieces {
+ public:
+  void add(std::string piece) { pieces_.push_back(std::move(piece)); }
+  // Formats items [0, count) in blocks on all cores; the blocks keep their
+  // order, so the bytes are the same whatever the thread count.
+  template <class Format>
+  void add_in_blocks(size_t count, size_t bytes_per_item, Format format) {
+    constexpr size_t kBlock = 16384;
+    const size_t first = pieces_.size();
+    pieces_.resize(first + (count + kBlock - 1) / kBlock);
+    tbb::parallel_for(first, pieces_.size(), [&](size_t b) {
+      const size_t begin = (b - first) * kBlock, end = std::min(count, begin + kBlock);
+      TextBuffer part((end - begin) * bytes_per_item);
+      for (size_t i = begin; i < end; ++i) format(part, i);
+      pieces_[b] = std::move(part).take();
+    });
+  }
+  std::string join() && {
+    size_t total = 0;
+    for (const std::string& p : pieces_) total += p.size();
+    std::string out;
+    out.reserve(total);
+    for (std::string& p : pieces_) {
+      out += p;
+      std::string().swap(p);  // free as we go: peak memory about the file's size
+    }
+    return out;
+  }
+
+ private:
+  std::vector<std::string> pieces_;
+};
 
 template <class Vector>
 void put_obj_vector(TextBuffer& out, std::string_view keyword, const Vector& vector) {
@@ -347,25 +370,29 @@ void put_obj_face(TextBuffer& out, const glm::uvec3& tri, bool normals) {
 
 std::string encode_obj(const ContourMesh& mesh, const MaterialGroups& groups,
                        const ExportOptions& options) {
-  TextBuffer out(mesh.vertex_count() * 90 + mesh.triangle_count() * 40 + 4096);
-  append_obj_header(out, groups, options);
-  append_in_parallel(out, mesh.vertex_count(), 64, [&](TextBuffer& part, size_t v) {
+  TextPieces out;
+  TextBuffer header(4096);
+  append_obj_header(header, groups, options);
+  out.add(std::move(header).take());
+  out.add_in_blocks(mesh.vertex_count(), 64, [&](TextBuffer& part, size_t v) {
     put_obj_vector(part, "v", mesh.positions[v]);
   });
-  append_in_parallel(out, mesh.normals.size(), 40, [&](TextBuffer& part, size_t v) {
+  out.add_in_blocks(mesh.normals.size(), 40, [&](TextBuffer& part, size_t v) {
     put_obj_vector(part, "vn", mesh.normals[v]);
   });
+  // Faces in the mesh's own order (a round trip keeps it), a usemtl line
+  // wherever the material changes.
   const bool normals = !mesh.normals.empty();
-  for (size_t g = 0; g < groups.material.size(); ++g) {
-    out.put("usemtl ");
-    out.put(material_name(options, groups.material[g]));
-    out.put('\n');
-    const size_t first = groups.group_start[g];
-    append_in_parallel(out, groups.group_start[g + 1] - first, 48, [&](TextBuffer& part, size_t i) {
-      put_obj_face(part, mesh.triangles[groups.order[first + i]], normals);
-    });
-  }
-  return std::move(out).take();
+  out.add_in_blocks(mesh.triangle_count(), 48, [&](TextBuffer& part, size_t t) {
+    const uint16_t material = material_of(mesh, t);
+    if (t == 0 || material != material_of(mesh, t - 1)) {
+      part.put("usemtl ");
+      part.put(material_name(options, material));
+      part.put('\n');
+    }
+    put_obj_face(part, mesh.triangles[t], normals);
+  });
+  return std::move(out).join();
 }
 
 // -------------------------------------------------------------------- PLY
@@ -441,45 +468,8 @@ Result<std::string> encode_stl(const ContourMesh& mesh, const std::string& path)
 
 // ------------------------------------------------------------------- files
 
-std::string errno_text(int error) { return std::strerror(error); }
 
-// Through path + ".tmp" and a rename, so a failed export leaves no
-// half-written file where the caller expects one.
-Status write_atomically(const std::string& path, const std::string& bytes) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (!file) {
-    return error_at(ErrorCode::kIoError, path, "cannot create '" + tmp + "': " + errno_text(errno));
-  }
-  bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size();
-  int error = errno;
-  if (std::fclose(file) != 0 && ok) {
-    ok = false;
-    error = errno;
-  }
-  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
-    ok = false;
-    error = errno;
-  }
-  if (!ok) {
-    std::remove(tmp.c_str());
-    return error_at(ErrorCode::kIoError, path, "cannot write: " + errno_text(error));
-  }
-  return {};
-}
-
-Result<std::string> read_whole_file(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return error_at(ErrorCode::kIoError, path, "cannot open: " + errno_text(errno));
-  std::string bytes;
-  char chunk[1 << 16];
-  size_t got = 0;
-  while ((got = std::fread(chunk, 1, sizeof(chunk), file)) > 0) bytes.append(chunk, got);
-  const bool failed = std::ferror(file) != 0;
-  std::fclose(file);
-  if (failed) return error_at(ErrorCode::kIoError, path, "read error");
-  return bytes;
-}
+std::string encode_off(const ContourMesh& mesh);  // below, beside the OFF reader
 
 Result<std::string> encode(const ContourMesh& mesh, MeshFormat format, const ExportOptions& options,
                            const std::string& path) {
@@ -494,6 +484,8 @@ Result<std::string> encode(const ContourMesh& mesh, MeshFormat format, const Exp
       return encode_ply(mesh, path);
     case MeshFormat::kStl:
       return encode_stl(mesh, path);
+    case MeshFormat::kOff:
+      return encode_off(mesh);
     case MeshFormat::kGlb:
       return encode_glb(mesh, options, path);
     case MeshFormat::kDraco:
@@ -570,13 +562,13 @@ uint16_t obj_material_id(const std::string& name, uint16_t parsed_id, const ObjE
   return parsed_id;
 }
 
-Result<ContourMesh> decode_obj(std::string_view bytes, const std::string& path) {
+Result<ContourMesh> decode_obj(std::string_view bytes, const std::string& path, const LoadOptions& options) {
   ObjExtras extras = scan_obj(bytes);
   ContourMesh mesh;
   if (!extras.has_faces) {
     mesh.positions = std::move(extras.positions);
   } else {
-    Result<TriangleMesh> parsed = parse_obj(bytes, path);
+    Result<TriangleMesh> parsed = parse_obj(bytes, path, options);
     if (!parsed.ok()) return parsed.status();
     TriangleMesh& tm = parsed.value();
     std::vector<uint16_t> ids(tm.material_names.size());
@@ -684,14 +676,14 @@ Result<ContourMesh> read_own_ply(std::string_view bytes, const std::array<size_t
   return mesh;
 }
 
-Result<ContourMesh> decode_ply(std::string_view bytes, const std::string& path) {
+Result<ContourMesh> decode_ply(std::string_view bytes, const std::string& path, const LoadOptions& options) {
   ContourMesh mesh;
   if (const auto layout = own_ply_layout(bytes)) {
     Result<ContourMesh> own = read_own_ply(bytes, *layout, path);
     if (!own.ok()) return own.status();
     mesh = std::move(own.value());
   } else {  // someone else's PLY: positions and triangles only
-    Result<TriangleMesh> parsed = parse_ply(bytes, path);
+    Result<TriangleMesh> parsed = parse_ply(bytes, path, options);
     if (!parsed.ok()) return parsed.status();
     mesh.positions = std::move(parsed->positions);
     mesh.triangles = std::move(parsed->triangles);
@@ -702,12 +694,12 @@ Result<ContourMesh> decode_ply(std::string_view bytes, const std::string& path) 
 
 // ------------------------------------------------------------ STL reading
 
-Result<ContourMesh> decode_stl(std::string_view bytes, const std::string& path) {
+Result<ContourMesh> decode_stl(std::string_view bytes, const std::string& path, const LoadOptions& options) {
   ContourMesh mesh;
   // parse_stl refuses a file without triangles; ours writes one for an empty mesh.
   const bool empty = bytes.size() == kStlHeaderBytes && load_le<uint32_t>(bytes.data() + 80) == 0;
   if (!empty) {
-    Result<TriangleMesh> parsed = parse_stl(bytes, path);
+    Result<TriangleMesh> parsed = parse_stl(bytes, path, options);
     if (!parsed.ok()) return parsed.status();
     mesh.positions = std::move(parsed->positions);
     mesh.triangles = std::move(parsed->triangles);
@@ -716,23 +708,80 @@ Result<ContourMesh> decode_stl(std::string_view bytes, const std::string& path) 
   return mesh;
 }
 
-Result<ContourMesh> decode(std::string_view bytes, MeshFormat format, const std::string& path) {
-  switch (format) {
-    case MeshFormat::kObj:
-      return decode_obj(bytes, path);
-    case MeshFormat::kPly:
-      return decode_ply(bytes, path);
-    case MeshFormat::kStl:
-      return decode_stl(bytes, path);
-    case MeshFormat::kGlb:
-      return decode_glb(bytes, path);
-    case MeshFormat::kDraco:
-      return decode_draco(bytes, path);
+// ------------------------------------------------------------ OFF
+
+std::string encode_off(const ContourMesh& mesh) {
+  TextPieces out;
+  out.add("OFF\n" + std::to_string(mesh.vertex_count()) + ' ' + std::to_string(mesh.triangle_count()) + " 0\n");
+  out.add_in_blocks(mesh.vertex_count(), 64, [&](TextBuffer& part, size_t v) {
+    for (int axis = 0; axis < 3; ++axis) {
+      if (axis) part.put(' ');
+      part.number(mesh.positions[v][axis]);
+    }
+    part.put('\n');
+  });
+  out.add_in_blocks(mesh.triangle_count(), 40, [&](TextBuffer& part, size_t t) {
+    part.put('3');
+    for (int k = 0; k < 3; ++k) {
+      part.put(' ');
+      part.number(uint64_t{mesh.triangles[t][k]});
+    }
+    part.put('\n');
+  });
+  return std::move(out).join();
+}
+
+Result<ContourMesh> decode_off(std::string_view bytes, const std::string& path, const LoadOptions& options) {
+  Result<TriangleMesh> parsed = parse_off(bytes, path, options);
+  if (!parsed.ok()) return parsed.status();
+  ContourMesh mesh;
+  mesh.positions = std::move(parsed->positions);
+  mesh.triangles = std::move(parsed->triangles);
+  complete_loaded_mesh(mesh);
+  return mesh;
+}
+
+Result<ContourMesh> decode(std::string_view bytes, MeshFormat format, const std::string& path,
+                           const LoadOptions& options) {
+  Result<ContourMesh> mesh = [&]() -> Result<ContourMesh> {
+    switch (format) {
+      case MeshFormat::kObj: return decode_obj(bytes, path, options);
+      case MeshFormat::kPly: return decode_ply(bytes, path, options);
+      case MeshFormat::kStl: return decode_stl(bytes, path, options);
+      case MeshFormat::kOff: return decode_off(bytes, path, options);
+      case MeshFormat::kGlb: return decode_glb(bytes, path);
+      case MeshFormat::kDraco: return decode_draco(bytes, path);
+    }
+    return error_at(ErrorCode::kInternal, path, "unknown MeshFormat");
+  }();
+  if (mesh.ok() && mesh->triangle_count() > options.max_triangles) {
+    return error_at(ErrorCode::kTooLarge, path,
+                    std::to_string(mesh->triangle_count()) + " triangles exceed the limit of " +
+                        std::to_string(options.max_triangles));
   }
-  return error_at(ErrorCode::kInternal, path, "unknown MeshFormat");
+  return mesh;
+}
+
+// Materials of a TriangleMesh written under its own names unless the caller named them.
+ExportOptions with_material_names(const TriangleMesh& mesh, const ExportOptions& options) {
+  ExportOptions named = options;
+  if (named.material_names.empty()) named.material_names = mesh.material_names;
+  return named;
 }
 
 }  // namespace
+
+const char* mesh_format_name(MeshFormat format) {
+  switch (format) {
+    case MeshFormat::kObj: return "obj";
+    case MeshFormat::kPly: return "ply";
+    case MeshFormat::kStl: return "stl";
+    case MeshFormat::kOff: return "off";
+    case MeshFormat::kGlb: return "glb";
+    case MeshFormat::kDraco: return "drc";
+  }
+  return "unknown";
+}
 
 Result<MeshFormat> mesh_format_from_path(const std::string& path) {
   const size_t slash = path.find_last_of("/\\");
@@ -742,19 +791,16 @@ Result<MeshFormat> mesh_format_from_path(const std::string& path) {
     extension = path.substr(dot + 1);
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   }
-  if (extension == "obj") return MeshFormat::kObj;
-  if (extension == "ply") return MeshFormat::kPly;
-  if (extension == "stl") return MeshFormat::kStl;
-  if (extension == "glb") return MeshFormat::kGlb;
-  if (extension == "drc") return MeshFormat::kDraco;
+  for (MeshFormat f : {MeshFormat::kObj, MeshFormat::kPly, MeshFormat::kStl, MeshFormat::kOff, MeshFormat::kGlb,
+                       MeshFormat::kDraco}) {
+    if (extension == mesh_format_name(f)) return f;
+  }
   const std::string shown = extension.empty() ? "no extension" : "'." + path.substr(dot + 1) + "'";
-  return error_at(
-      ErrorCode::kUnsupported, path,
-      "unsupported mesh file type (" + shown + "; expected .obj, .ply, .stl, .glb or .drc)");
+  return error_at(ErrorCode::kUnsupported, path,
+                  "unsupported mesh file type (" + shown + "; expected .obj, .ply, .stl, .off, .glb or .drc)");
 }
 
-Status save_contour_mesh(const ContourMesh& mesh, const std::string& path,
-                         const ExportOptions& options) {
+Status save_mesh(const ContourMesh& mesh, const std::string& path, const ExportOptions& options) {
   Result<MeshFormat> format = mesh_format_from_path(path);
   if (!format.ok()) return format.status();
   Status status = check_options(options, format.value(), path);
@@ -763,7 +809,7 @@ Status save_contour_mesh(const ContourMesh& mesh, const std::string& path,
   try {  // no exception crosses the API, whatever the encoders' libraries throw
     Result<std::string> bytes = encode(mesh, format.value(), options, path);
     if (!bytes.ok()) return bytes.status();
-    return write_atomically(path, bytes.value());
+    return write_file_atomically(path, bytes.value());
   } catch (const std::bad_alloc&) {
     return error_at(ErrorCode::kTooLarge, path, "out of memory while encoding");
   } catch (const std::exception& e) {
@@ -771,13 +817,18 @@ Status save_contour_mesh(const ContourMesh& mesh, const std::string& path,
   }
 }
 
-Result<ContourMesh> load_contour_mesh(const std::string& path) {
+Status save_mesh(const TriangleMesh& mesh, const std::string& path, const ExportOptions& options) {
+  if (Status s = check_mesh(mesh, path); !s.ok()) return s;
+  return save_mesh(to_contour_mesh(mesh), path, with_material_names(mesh, options));
+}
+
+Result<ContourMesh> load_contour_mesh(const std::string& path, const LoadOptions& options) {
   Result<MeshFormat> format = mesh_format_from_path(path);
   if (!format.ok()) return format.status();
   try {
-    Result<std::string> bytes = read_whole_file(path);
+    Result<std::string> bytes = read_file(path);
     if (!bytes.ok()) return bytes.status();
-    return decode(bytes.value(), format.value(), path);
+    return decode(bytes.value(), format.value(), path, options);
   } catch (const std::bad_alloc&) {
     return error_at(ErrorCode::kTooLarge, path, "out of memory while reading");
   } catch (const std::exception& e) {
@@ -785,11 +836,41 @@ Result<ContourMesh> load_contour_mesh(const std::string& path) {
   }
 }
 
+Result<TriangleMesh> load_mesh(const std::string& path, const LoadOptions& options) {
+  using Parser = Result<TriangleMesh> (*)(std::string_view, std::string_view, const LoadOptions&);
+  Result<MeshFormat> format = mesh_format_from_path(path);
+  if (!format.ok()) return format.status();
+  const MeshFormat f = format.value();
+  Parser parser = f == MeshFormat::kObj   ? parse_obj
+                  : f == MeshFormat::kPly ? parse_ply
+                  : f == MeshFormat::kStl ? parse_stl
+                  : f == MeshFormat::kOff ? parse_off
+                                          : nullptr;
+  if (!parser) {  // GLB, Draco: through the ContourMesh decoders
+    Result<ContourMesh> mesh = load_contour_mesh(path, options);
+    if (!mesh.ok()) return mesh.status();
+    if (mesh->triangles.empty()) return error_at(ErrorCode::kParseError, path, "no triangles");
+    return to_triangle_mesh(mesh.value());
+  }
+  Result<std::string> bytes = read_file(path);
+  if (!bytes.ok()) return bytes.status();
+  return parser(bytes.value(), path, options);
+}
+
 TriangleMesh to_triangle_mesh(const ContourMesh& mesh) {
   TriangleMesh out;
   out.positions = mesh.positions;
   out.triangles = mesh.triangles;
   out.triangle_material = mesh.triangle_material;
+  return out;
+}
+
+ContourMesh to_contour_mesh(const TriangleMesh& mesh) {
+  ContourMesh out;
+  out.positions = mesh.positions;
+  out.triangles = mesh.triangles;
+  out.triangle_material = mesh.triangle_material;
+  complete_loaded_mesh(out);
   return out;
 }
 

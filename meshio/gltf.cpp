@@ -13,11 +13,12 @@
 #include <sstream>
 #include <string>
 
-#include "contour/detail/export.h"
+#include "ldc/materials.h"
+#include "meshio/detail/codecs.h"
 #define TINYGLTF_IMPLEMENTATION
-#include "contour/detail/tiny_gltf.h"
+#include "meshio/detail/tiny_gltf.h"
 
-namespace ldc::export_detail {
+namespace ldc::meshio_detail {
 namespace {
 
 namespace gltf = ::ldc_tinygltf;
@@ -25,17 +26,10 @@ namespace gltf = ::ldc_tinygltf;
 constexpr const char* kMaterialAttribute = "_MATERIAL";
 constexpr const char* kMaterialIdExtra = "ldc_material";
 
-// A stable colour per material id (splitmix64 of the id), kept away from
-// black and white so that neighbouring materials are told apart.
+// The palette's linear albedo (ldc/materials.h), opaque: what baseColorFactor holds.
 std::vector<double> material_colour(uint16_t id) {
-  uint64_t h = id + 0x9E3779B97F4A7C15ull;
-  h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
-  h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
-  h ^= h >> 31;
-  std::vector<double> rgba(4, 1.0);
-  for (int c = 0; c < 3; ++c)
-    rgba[c] = 0.15 + 0.75 * static_cast<double>((h >> (16 * c)) & 0xffff) / 65535.0;
-  return rgba;
+  const glm::vec3 albedo = material_albedo(id);
+  return {albedo.x, albedo.y, albedo.z, 1.0};
 }
 
 int add_view(gltf::Model& model, size_t offset, size_t length, int target, size_t stride = 0) {
@@ -404,4 +398,4 @@ Result<ContourMesh> decode_glb(std::string_view bytes, const std::string& path) 
   return GltfReader(model, path).read();
 }
 
-}  // namespace ldc::export_detail
+}  // namespace ldc::meshio_detail

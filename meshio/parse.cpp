@@ -5,7 +5,7 @@
 // read from a header are checked against the bytes actually present before
 // anything is reserved, polygons are triangulated by one shared ear clipper,
 // and every refusal names the file plus a line (text) or byte offset (binary).
-#include "ldc/mesh.h"
+#include "meshio/meshio.h"
 
 #include <algorithm>
 #include <array>
@@ -1295,34 +1295,6 @@ Result<TriangleMesh> guarded(std::string_view bytes, std::string_view name,
   }
 }
 
-Result<std::string> read_whole_file(const std::string& path) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file)
-    return Status(ErrorCode::kIoError, concat("cannot open '", path, "': ", std::strerror(errno)));
-  std::string bytes;
-  char buffer[1 << 16];
-  size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof(buffer), file)) > 0) bytes.append(buffer, got);
-  const bool failed = std::ferror(file) != 0;
-  const int error = errno;
-  std::fclose(file);
-  if (failed)
-    return Status(ErrorCode::kIoError, concat("cannot read '", path, "': ", std::strerror(error)));
-  return bytes;
-}
-
-// The extension after the file name's last dot, lower case, or "" if none.
-std::string lowercase_extension(const std::string& path) {
-  const size_t slash = path.find_last_of("/\\");
-  const std::string_view file_name =
-      std::string_view(path).substr(slash == std::string::npos ? 0 : slash + 1);
-  const size_t dot = file_name.rfind('.');
-  if (dot == std::string_view::npos) return {};
-  std::string extension(file_name.substr(dot + 1));
-  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return extension;
-}
-
 }  // namespace
 
 Result<TriangleMesh> parse_obj(std::string_view bytes, std::string_view name,
@@ -1346,31 +1318,6 @@ Result<TriangleMesh> parse_stl(std::string_view bytes, std::string_view name,
 Result<TriangleMesh> parse_off(std::string_view bytes, std::string_view name,
                                const LoadOptions& options) {
   return guarded(bytes, name, options, [&] { return OffParser(bytes, name, options).parse(); });
-}
-
-Result<TriangleMesh> load_mesh(const std::string& path, const LoadOptions& options) {
-  using Parser = Result<TriangleMesh> (*)(std::string_view, std::string_view, const LoadOptions&);
-  const std::string extension = lowercase_extension(path);
-  Parser parser = extension == "obj"   ? parse_obj
-                  : extension == "ply" ? parse_ply
-                  : extension == "stl" ? parse_stl
-                  : extension == "off" ? parse_off
-                                       : nullptr;
-  if (!parser) {
-    const std::string shown =
-        extension.empty() ? std::string("no extension") : "'." + extension + "'";
-    return Status(ErrorCode::kUnsupported, concat(path, ": unsupported mesh file type (", shown,
-                                                  "; expected .obj, .ply, .stl or .off)"));
-  }
-  Result<std::string> bytes = [&]() -> Result<std::string> {
-    try {
-      return read_whole_file(path);
-    } catch (const std::bad_alloc&) {
-      return Status(ErrorCode::kTooLarge, concat(path, ": out of memory while reading"));
-    }
-  }();
-  if (!bytes.ok()) return bytes.status();
-  return parser(bytes.value(), path, options);
 }
 
 }  // namespace ldc

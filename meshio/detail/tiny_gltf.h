@@ -6,7 +6,7 @@
 // both, which copy a call reaches depends on the link order, and the wrong
 // one crashes (seen: TinyGLTF::LoadBinaryFromFile resolved into libdraco).
 // Under a renamed namespace nothing can interpose ldc's copy. Its
-// implementation is compiled once, in export_gltf.cpp.
+// implementation is compiled once, in gltf.cpp.
 //
 // Images are never decoded or written (ldc writes none and ignores those of
 // files it reads), so STB is left out; JSON is nlohmann's.

@@ -1,0 +1,79 @@
+// render_gi(): primary hits lit by a GI engine's irradiance; tone mapping
+// and images side by side.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "render/render.h"
+
+namespace ldc {
+
+Result<RadianceImage> render_gi(const Queries& queries, const Camera& cam, GiEngine& gi,
+                                const MaterialTable& materials, const SkyLight& sky, int bounces) {
+  if (bounces < 1 || bounces > 3) {
+    return Status(ErrorCode::kInvalidArgument, "bounces " + std::to_string(bounces) + ": must be 1 .. 3");
+  }
+  const size_t n = size_t(cam.width()) * size_t(cam.height());
+  std::vector<Ray> rays(n);
+  std::vector<RayHit> hits(n);
+  for (int y = 0; y < cam.height(); ++y)
+    for (int x = 0; x < cam.width(); ++x) rays[size_t(y) * size_t(cam.width()) + size_t(x)] = cam.pixel_ray(x, y);
+  if (Status s = queries.ray_cast(rays, hits, nullptr); !s.ok()) return s;
+  std::vector<glm::dvec3> p;
+  std::vector<glm::vec3> nrm;
+  std::vector<size_t> pix;
+  RadianceImage out{cam.width(), cam.height(), std::vector<glm::vec3>(n, glm::vec3(0.0f))};
+  for (size_t i = 0; i < n; ++i) {
+    if (!hits[i].hit || hits[i].started_inside) {
+      out.pixels[i] = hits[i].hit ? glm::vec3(0.0f) : sky.radiance(glm::normalize(glm::vec3(rays[i].direction)));
+      continue;
+    }
+    p.push_back(hits[i].point);
+    nrm.push_back(hits[i].normal);
+    pix.push_back(i);
+  }
+  std::vector<glm::vec3> e(p.size());
+  if (Status s = gi.irradiance(p, nrm, bounces, e); !s.ok()) return s;
+  for (size_t k = 0; k < pix.size(); ++k) {
+    const VoxelMaterial& m = materials[hits[pix[k]].material];
+    out.pixels[pix[k]] = m.albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + m.emission;
+  }
+  return out;
+}
+
+namespace {
+
+uint8_t tone(float v, float exposure) {
+  v *= exposure;
+  if (!(v > 0.0f)) return 0;
+  v = v / (1.0f + v);
+  return uint8_t(std::lround(255.0f * std::pow(std::clamp(v, 0.0f, 1.0f), 1.0f / 2.2f)));
+}
+
+}  // namespace
+
+Image tone_map(const RadianceImage& radiance, float exposure) {
+  Image img{radiance.width, radiance.height, std::vector<uint8_t>(radiance.pixels.size() * 3)};
+  for (size_t i = 0; i < radiance.pixels.size(); ++i) {
+    for (int k = 0; k < 3; ++k) img.rgb[3 * i + size_t(k)] = tone(radiance.pixels[i][k], exposure);
+  }
+  return img;
+}
+
+Result<Image> side_by_side(const Image& left, const Image& right) {
+  if (left.height != right.height) {
+    return Status(ErrorCode::kInvalidArgument, "side_by_side: heights " + std::to_string(left.height) + " and " +
+                                                   std::to_string(right.height) + " differ");
+  }
+  Image out{left.width + right.width, left.height, {}};
+  out.rgb.reserve(left.rgb.size() + right.rgb.size());
+  for (int y = 0; y < out.height; ++y) {
+    const auto row = [y](const Image& img) { return img.rgb.begin() + 3 * ptrdiff_t(y) * img.width; };
+    out.rgb.insert(out.rgb.end(), row(left), row(left) + 3 * ptrdiff_t(left.width));
+    out.rgb.insert(out.rgb.end(), row(right), row(right) + 3 * ptrdiff_t(right.width));
+  }
+  return out;
+}
+
+}  // namespace ldc
