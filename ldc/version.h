@@ -16,9 +16,9 @@
 #pragma once
 
 #define LDC_VERSION_MAJOR 0
-#define LDC_VERSION_MINOR 2
+#define LDC_VERSION_MINOR 3
 #define LDC_VERSION_PATCH 0
-#define LDC_VERSION_STRING "0.2.0"
+#define LDC_VERSION_STRING "0.3.0"
 
 // One number for comparisons: major * 10000 + minor * 100 + patch.
 #define LDC_VERSION (LDC_VERSION_MAJOR * 10000 + LDC_VERSION_MINOR * 100 + LDC_VERSION_PATCH)

@@ -3,6 +3,7 @@
 # folders, then configures, builds and runs tests/install/consumer against
 # the package with find_package(ldc). Run by ctest (label install):
 #   cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -P run_install_test.cmake
+cmake_policy(VERSION 3.20)
 foreach(var BUILD_DIR CONSUMER_DIR WORK_DIR)
   if(NOT ${var})
     message(FATAL_ERROR "run_install_test.cmake: -D${var}= is required")
@@ -59,3 +60,31 @@ run(${CMAKE_COMMAND} -S ${CONSUMER_DIR} -B ${build} -G ${GENERATOR} -DCMAKE_BUIL
 run(${CMAKE_COMMAND} --build ${build})
 run(${build}/consumer)
 run(${build}/consumer_c)
+
+# Each component alone, with every package it does not need made unfindable:
+# the package must find only what the component links (issue 18: a consumer
+# of the C API needs no dev package at all).
+set(all_packages glm TBB zstd PkgConfig meshoptimizer OpenMesh draco Vulkan)
+set(core_packages glm TBB zstd PkgConfig)
+set(needs_core ${core_packages})
+set(needs_contour ${core_packages} meshoptimizer)
+set(needs_meshio ${core_packages} meshoptimizer draco)
+set(needs_csg ${core_packages})
+set(needs_nav ${core_packages})
+set(needs_voxelize ${core_packages})
+set(needs_live ${core_packages} meshoptimizer)
+set(needs_render ${core_packages})
+set(needs_c "")
+foreach(component core contour meshio csg nav voxelize live render c)
+  set(disabled)
+  foreach(package ${all_packages})
+    if(NOT package IN_LIST needs_${component})
+      list(APPEND disabled -DCMAKE_DISABLE_FIND_PACKAGE_${package}=ON)
+    endif()
+  endforeach()
+  set(component_build ${WORK_DIR}/component_${component})
+  run(${CMAKE_COMMAND} -S ${CONSUMER_DIR}/../component -B ${component_build} -G ${GENERATOR}
+      -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix} -DLDC_COMPONENT=${component} ${disabled} ${compilers})
+  run(${CMAKE_COMMAND} --build ${component_build})
+  run(${component_build}/component)
+endforeach()
