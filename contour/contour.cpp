@@ -12,7 +12,7 @@
 
 #include "contour/detail/mesh_patch.h"
 #include "contour/detail/region_mesher.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc {
 

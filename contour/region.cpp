@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc::detail {
 

@@ -7,7 +7,7 @@
 
 #include "csg/csg.h"
 #include "csg/detail/merge.h"
-#include "internal/build_common.h"
+#include "ldc/internal/build_common.h"
 
 namespace ldc {
 namespace {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "csg/detail/brush_raster.h"
-#include "internal/build_common.h"
+#include "ldc/internal/build_common.h"
 
 namespace ldc::detail {
 namespace {

@@ -7,8 +7,8 @@
 
 #include "csg/csg.h"
 #include "csg/detail/merge.h"
-#include "internal/build_common.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/build_common.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc {
 

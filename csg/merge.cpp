@@ -4,7 +4,7 @@
 #include <vector>
 
 #include "csg/detail/merge.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc::detail {
 namespace {

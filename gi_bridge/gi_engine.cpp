@@ -7,7 +7,7 @@
 #include <sstream>
 
 #include "gi_bridge/detail/gi_engine.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 
 namespace ldc {
 

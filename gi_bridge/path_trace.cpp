@@ -9,7 +9,7 @@
 #include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>
 
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 
 namespace ldc {
 

@@ -4,8 +4,8 @@
 
 #include <tbb/parallel_for.h>
 
-#include "internal/build_common.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/build_common.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc::detail {
 namespace {

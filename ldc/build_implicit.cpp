@@ -8,7 +8,7 @@
 #include <tbb/parallel_for.h>
 
 #include "ldc/build.h"
-#include "internal/build_common.h"
+#include "ldc/internal/build_common.h"
 
 namespace ldc {
 

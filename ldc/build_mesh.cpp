@@ -16,9 +16,9 @@
 #include <tbb/parallel_sort.h>
 
 #include "ldc/build.h"
-#include "internal/build_common.h"
+#include "ldc/internal/build_common.h"
 #include "ldc/detail/mesh_raster.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc {
 namespace detail {

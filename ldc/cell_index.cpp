@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc::detail {
 namespace {

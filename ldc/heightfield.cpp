@@ -6,7 +6,7 @@
 #include <stb_image.h>
 
 #include "ldc/build.h"
-#include "internal/build_common.h"
+#include "ldc/internal/build_common.h"
 
 namespace ldc {
 namespace {

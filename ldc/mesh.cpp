@@ -7,7 +7,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 
 namespace ldc {
 namespace {

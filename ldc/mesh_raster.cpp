@@ -6,9 +6,9 @@
 
 #include <tbb/parallel_for.h>
 
-#include "internal/build_common.h"
+#include "ldc/internal/build_common.h"
 #include "ldc/detail/mesh_raster.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc::detail {
 

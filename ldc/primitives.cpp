@@ -7,7 +7,7 @@
 #include <utility>
 
 #include "ldc/build.h"
-#include "internal/build_common.h"
+#include "ldc/internal/build_common.h"
 
 namespace ldc {
 

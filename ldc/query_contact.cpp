@@ -8,8 +8,8 @@
 #include <type_traits>
 
 #include "ldc/detail/cell_index.h"
-#include "internal/ray_math.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/ray_math.h"
+#include "ldc/internal/vec_text.h"
 #include "ldc/query.h"
 
 namespace ldc {

@@ -9,7 +9,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 #include "ldc/world.h"
 
 namespace ldc {

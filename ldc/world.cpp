@@ -8,7 +8,7 @@
 #include <cstring>
 #include <limits>
 
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 
 namespace ldc {
 

@@ -26,7 +26,7 @@
 #include <unordered_map>
 #include <utility>
 
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
 #include "meshio/detail/codecs.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 #include "nav/detail/nav_data.h"
 #include "nav/detail/nav_search.h"
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <sstream>
 
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 #include "render/detail/up.h"
 #include "render/render.h"
 

@@ -8,7 +8,7 @@
 
 #include <tbb/parallel_for.h>
 
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 #include "ldc/materials.h"
 #include "render/detail/up.h"
 #include "render/render.h"

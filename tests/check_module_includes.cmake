@@ -1,5 +1,5 @@
 # Fails when a module includes another module's detail/ headers: what modules
-# share lives in internal/ (see internal/README.md).
+# share lives in ldc/internal/ (see ldc/internal/README.md).
 # Usage: cmake -DSOURCE_DIR=<repo> -P check_module_includes.cmake
 set(modules ldc contour csg nav voxelize gi_bridge live meshio render capi tools examples)
 set(violations 0)

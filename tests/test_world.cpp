@@ -5,7 +5,7 @@
 #include <random>
 
 #include "ldc/build.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 #include "test_util.h"
 
 namespace ldc {

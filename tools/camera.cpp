@@ -3,7 +3,7 @@
 #include <sstream>
 
 #include "common.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 
 namespace ldc::tool {
 

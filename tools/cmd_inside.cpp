@@ -7,7 +7,7 @@
 
 #include "common.h"
 #include "ldc/io.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 
 namespace ldc::tool {
 namespace {

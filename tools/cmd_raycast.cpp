@@ -9,7 +9,7 @@
 
 #include "camera.h"
 #include "common.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
 

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "common.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
 #include "voxelize/vdb.h"
 #include "voxelize/voxelize.h"

@@ -11,7 +11,7 @@
 
 #include <tbb/global_control.h>
 
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 
 namespace ldc::tool {
 

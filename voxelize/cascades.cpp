@@ -10,8 +10,8 @@
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
-#include "internal/ray_math.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/ray_math.h"
+#include "ldc/internal/vec_text.h"
 #include "voxelize/detail/voxel_common.h"
 #include "voxelize/voxelize.h"
 

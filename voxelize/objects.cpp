@@ -4,7 +4,7 @@
 #include <string>
 
 #include "ldc/build.h"
-#include "internal/vec_text.h"
+#include "ldc/internal/vec_text.h"
 #include "voxelize/detail/objects.h"
 
 namespace ldc {

@@ -8,7 +8,7 @@
 #include <limits>
 
 #include "ldc/detail/cell_index.h"
-#include "internal/ray_math.h"
+#include "ldc/internal/ray_math.h"
 #include "ldc/query.h"
 
 namespace ldc::detail {
