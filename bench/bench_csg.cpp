@@ -37,7 +37,7 @@ namespace {
 using ldc::BooleanOp;
 using ldc::TriangleMesh;
 
-const BooleanOp kOps[] = {BooleanOp::kDifference, BooleanOp::kUnion, BooleanOp::kIntersection};
+const BooleanOp kOps[] = {BooleanOp::kSubtract, BooleanOp::kUnion, BooleanOp::kIntersect};
 
 const char* op_name(BooleanOp op) { return ldc::boolean_op_name(op); }
 

@@ -42,7 +42,7 @@ std::vector<GameEdit> game_edits(const ldc::World& w) {
   return {
       {"sphere dig r=2m", ldc::Brush::sphere({x, y, z}, 2.0), ldc::EditOp::kSubtract},
       {"box build 2x2x2m", ldc::Brush::box({x + 6.0, y, ground_height(w, x + 6.0, y) + 0.9}, glm::dvec3(1.0), 2),
-       ldc::EditOp::kAdd},
+       ldc::EditOp::kUnion},
       {"paint stroke r=1m, 4m", ldc::Brush::capsule({x - 2, y - 6, z}, {x + 2, y - 6, z}, 1.0, 3), ldc::EditOp::kPaint},
       {"noise dig r=2m", ldc::Brush::noisy_sphere({x - 6, y, ground_height(w, x - 6, y)}, {.radius = 2.0}),
        ldc::EditOp::kSubtract},

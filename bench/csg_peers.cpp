@@ -69,8 +69,8 @@ template <class Mesh>
 bool corefine(Mesh& a, Mesh& b, Mesh& out, BooleanOp op) {
   switch (op) {
     case BooleanOp::kUnion: return PMP::corefine_and_compute_union(a, b, out);
-    case BooleanOp::kDifference: return PMP::corefine_and_compute_difference(a, b, out);
-    case BooleanOp::kIntersection: return PMP::corefine_and_compute_intersection(a, b, out);
+    case BooleanOp::kSubtract: return PMP::corefine_and_compute_difference(a, b, out);
+    case BooleanOp::kIntersect: return PMP::corefine_and_compute_intersection(a, b, out);
   }
   return false;
 }
@@ -152,8 +152,8 @@ TriangleMesh vdb_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp
   // Each leaves the result in its first argument and empties the second.
   switch (op) {
     case BooleanOp::kUnion: openvdb::tools::csgUnion(*ga, *gb); break;
-    case BooleanOp::kDifference: openvdb::tools::csgDifference(*ga, *gb); break;
-    case BooleanOp::kIntersection: openvdb::tools::csgIntersection(*ga, *gb); break;
+    case BooleanOp::kSubtract: openvdb::tools::csgDifference(*ga, *gb); break;
+    case BooleanOp::kIntersect: openvdb::tools::csgIntersection(*ga, *gb); break;
   }
   return vdb_to_mesh(*ga);
 }

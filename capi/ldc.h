@@ -169,10 +169,13 @@ typedef enum ldc_brush_shape {
 } ldc_brush_shape;
 
 typedef enum ldc_edit_op {
-  LDC_EDIT_DIG = 0,       /* subtract the brush */
-  LDC_EDIT_BUILD = 1,     /* add the brush (new surface takes its material) */
+  LDC_EDIT_SUBTRACT = 0,  /* world minus the brush (dig) */
+  LDC_EDIT_UNION = 1,     /* world union the brush (build; new surface takes its material) */
   LDC_EDIT_PAINT = 2,     /* surface inside the brush takes its material */
   LDC_EDIT_INTERSECT = 3, /* keep only what is inside the brush */
+  /* The 0.2 spellings, deprecated (removed after 0.3): */
+  LDC_EDIT_DIG = LDC_EDIT_SUBTRACT,
+  LDC_EDIT_BUILD = LDC_EDIT_UNION,
   LDC_EDIT_OP_MAX_ENUM = 0x7fffffff
 } ldc_edit_op;
 

@@ -310,13 +310,13 @@ static ldc::Result<ldc::Brush> to_brush(const ldc_brush& b) {
 
 static ldc::Result<ldc::EditOp> to_op(int32_t op) {
   switch (op) {
-    case LDC_EDIT_DIG: return ldc::EditOp::kSubtract;
-    case LDC_EDIT_BUILD: return ldc::EditOp::kAdd;
+    case LDC_EDIT_SUBTRACT: return ldc::EditOp::kSubtract;
+    case LDC_EDIT_UNION: return ldc::EditOp::kUnion;
     case LDC_EDIT_PAINT: return ldc::EditOp::kPaint;
     case LDC_EDIT_INTERSECT: return ldc::EditOp::kIntersect;
   }
   return ldc::Status(ldc::ErrorCode::kInvalidArgument,
-                     "edit op " + std::to_string(op) + ": use dig (0), build (1), paint (2) or intersect (3)");
+                     "edit op " + std::to_string(op) + ": use subtract (0), union (1), paint (2) or intersect (3)");
 }
 
 ldc_status ldc_world_edit(ldc_world* world, const ldc_brush* brush, ldc_edit_op op, ldc_edit_result* out) {

@@ -38,7 +38,7 @@ void result_box(const World& a, const World& b, BooleanOp op, WorldConfig& wc) {
   if (op == BooleanOp::kUnion) {
     lo = glm::min(lo, blo);
     hi = glm::max(hi, bhi);
-  } else if (op == BooleanOp::kIntersection) {
+  } else if (op == BooleanOp::kIntersect) {
     lo = glm::max(lo, blo);
     hi = glm::max(glm::min(hi, bhi), lo + 1);  // disjoint boxes: one empty chunk
   }
@@ -51,10 +51,19 @@ void result_box(const World& a, const World& b, BooleanOp op, WorldConfig& wc) {
 const char* boolean_op_name(BooleanOp op) {
   switch (op) {
     case BooleanOp::kUnion: return "union";
-    case BooleanOp::kDifference: return "difference";
-    case BooleanOp::kIntersection: return "intersection";
+    case BooleanOp::kSubtract: return "subtract";
+    case BooleanOp::kIntersect: return "intersect";
   }
   return "unknown";
+}
+
+std::optional<BooleanOp> boolean_op_from_name(std::string_view name) {
+  for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kSubtract, BooleanOp::kIntersect}) {
+    if (name == boolean_op_name(op)) return op;
+  }
+  if (name == "difference") return BooleanOp::kSubtract;
+  if (name == "intersection") return BooleanOp::kIntersect;
+  return std::nullopt;
 }
 
 Status check_boolean_config(const BooleanConfig& c) {

@@ -34,6 +34,8 @@
 #include <cstdint>
 #include <map>
 #include <memory>
+#include <optional>
+#include <string_view>
 #include <unordered_map>
 #include <vector>
 
@@ -46,8 +48,19 @@
 
 namespace ldc {
 
-enum class BooleanOp { kUnion, kDifference, kIntersection };
+// One name per operation across the C++ API, the C API, edit scripts and
+// the command line: union, subtract, intersect (and paint, for edits).
+enum class BooleanOp {
+  kUnion,
+  kSubtract,   // a minus b
+  kIntersect,
+  kDifference [[deprecated("use BooleanOp::kSubtract")]] = kSubtract,      // 0.2 spelling; removed after 0.3
+  kIntersection [[deprecated("use BooleanOp::kIntersect")]] = kIntersect,  // 0.2 spelling; removed after 0.3
+};
+// "union", "subtract", "intersect".
 const char* boolean_op_name(BooleanOp op);
+// By name; the 0.2 spellings "difference" and "intersection" are accepted.
+std::optional<BooleanOp> boolean_op_from_name(std::string_view name);
 
 struct BooleanConfig {
   // Spans and gaps thinner than this, between two lattice nodes, are removed.
@@ -118,12 +131,16 @@ Status check_brush(const Brush& brush);
 Result<World> rasterize_brush(const Brush& brush, const Lattice& lattice, int chunk_size);
 
 enum class EditOp {
-  kAdd,        // world union brush
-  kSubtract,   // world minus brush
+  kUnion,      // world union brush (build)
+  kSubtract,   // world minus brush (dig)
   kIntersect,  // world inside the brush only
   kPaint,      // surface points inside the brush take the brush's material
+  kAdd [[deprecated("use EditOp::kUnion")]] = kUnion,  // 0.2 spelling; removed after 0.3
 };
+// "union", "subtract", "intersect", "paint".
 const char* edit_op_name(EditOp op);
+// By name; the 0.2 spelling "add" is accepted.
+std::optional<EditOp> edit_op_from_name(std::string_view name);
 
 // What an edit changed, and how to take it back.
 struct EditReceipt {

@@ -43,9 +43,9 @@ std::string chunk_text(const glm::ivec3& c) {
 
 BooleanOp boolean_of(EditOp op) {
   switch (op) {
-    case EditOp::kAdd: return BooleanOp::kUnion;
-    case EditOp::kIntersect: return BooleanOp::kIntersection;
-    default: return BooleanOp::kDifference;
+    case EditOp::kUnion: return BooleanOp::kUnion;
+    case EditOp::kIntersect: return BooleanOp::kIntersect;
+    default: return BooleanOp::kSubtract;
   }
 }
 
@@ -86,7 +86,7 @@ std::vector<glm::ivec3> chunks_to_visit(const std::vector<PreparedEdit>& edits, 
     all_of_world = all_of_world || e.op == EditOp::kIntersect;
     if (e.empty) continue;
     glm::ivec3 lo = e.solid_chunk_lo, hi = e.solid_chunk_hi;
-    if (e.op != EditOp::kAdd) {  // subtracting or painting outside the world changes nothing
+    if (e.op != EditOp::kUnion) {  // subtracting or painting outside the world changes nothing
       lo = glm::max(lo, world.chunk_origin());
       hi = glm::min(hi, world.chunk_origin() + world.chunk_dims());
     }
@@ -144,12 +144,20 @@ void merge_dirty(std::map<uint64_t, DirtyChunk>& dirty, const glm::ivec3& chunk,
 
 const char* edit_op_name(EditOp op) {
   switch (op) {
-    case EditOp::kAdd: return "add";
+    case EditOp::kUnion: return "union";
     case EditOp::kSubtract: return "subtract";
     case EditOp::kIntersect: return "intersect";
     case EditOp::kPaint: return "paint";
   }
   return "unknown";
+}
+
+std::optional<EditOp> edit_op_from_name(std::string_view name) {
+  for (EditOp op : {EditOp::kUnion, EditOp::kSubtract, EditOp::kIntersect, EditOp::kPaint}) {
+    if (name == edit_op_name(op)) return op;
+  }
+  if (name == "add") return EditOp::kUnion;
+  return std::nullopt;
 }
 
 WorldEditor::WorldEditor(World world, BooleanConfig config) : world_(std::move(world)), config_(config) {}
@@ -177,7 +185,7 @@ Result<EditReceipt> WorldEditor::apply_batch(const std::vector<Edit>& edits, Con
   // Additions may reach past the world's box: check the grown box before changing anything.
   glm::ivec3 grow_lo = world_.chunk_origin(), grow_hi = world_.chunk_origin() + world_.chunk_dims();
   for (const PreparedEdit& e : prepared) {
-    if (e.op != EditOp::kAdd || e.empty) continue;
+    if (e.op != EditOp::kUnion || e.empty) continue;
     grow_lo = glm::min(grow_lo, e.solid_chunk_lo);
     grow_hi = glm::max(grow_hi, e.solid_chunk_hi);
   }

@@ -12,8 +12,8 @@ namespace {
 bool apply_op(BooleanOp op, bool a, bool b) {
   switch (op) {
     case BooleanOp::kUnion: return a || b;
-    case BooleanOp::kDifference: return a && !b;
-    case BooleanOp::kIntersection: return a && b;
+    case BooleanOp::kSubtract: return a && !b;
+    case BooleanOp::kIntersect: return a && b;
   }
   return false;
 }
@@ -87,7 +87,7 @@ void merge_ray(const RaySegment& a, const RaySegment& b, BooleanOp op, int cut_m
     bool a_alone = pa && apply_op(op, ia, b_before) != apply_op(op, a_before, b_before);
     if (a_alone || !pb) {
       filter.push(*pa);  // the result moves with a: same sense, same surface
-    } else if (op == BooleanOp::kDifference) {
+    } else if (op == BooleanOp::kSubtract) {
       uint16_t mat = cut_material >= 0 ? uint16_t(cut_material) : span_material(a.points, i);
       filter.push(reversed(*pb, mat));  // the cutter's surface, facing out of what remains
     } else {
@@ -210,7 +210,7 @@ MergedChunk merge_chunk(const ChunkView& a, const ChunkView& b, BooleanOp op, co
     const RayFamily& fa = family_of(a, k, scratch_a[k]);
     const RayFamily& fb = family_of(b, k, scratch_b[k]);
     if (fb.is_uniform()) {  // b decides alone: keep a, or make it uniform
-      bool keep_a = (op == BooleanOp::kIntersection) == fb.uniform_inside();
+      bool keep_a = (op == BooleanOp::kIntersect) == fb.uniform_inside();
       if (keep_a) {
         f.pick[k] = &fa;
         continue;

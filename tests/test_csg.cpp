@@ -65,7 +65,7 @@ constexpr double kPi = 3.14159265358979323846;
       for (int x = lo.x; x < hi.x; ++x) {
         glm::ivec3 n(x, y, z);
         bool ia = a.inside_node(n), ib = b.inside_node(n);
-        bool want = op == BooleanOp::kUnion ? (ia || ib) : op == BooleanOp::kDifference ? (ia && !ib) : (ia && ib);
+        bool want = op == BooleanOp::kUnion ? (ia || ib) : op == BooleanOp::kSubtract ? (ia && !ib) : (ia && ib);
         if (result.inside_node(n) != want) {
           return ::testing::AssertionFailure()
                  << "node (" << x << ", " << y << ", " << z << ") is " << (want ? "outside" : "inside");
@@ -104,17 +104,17 @@ glm::dvec3 point_position(const World& w, const glm::ivec3& ch, int axis, int ra
 
 TEST(Boolean, SelfIdentitiesAreExact) {
   Pair p = spot_and_sphere();
-  World diff = boolean(p.a, p.a, BooleanOp::kDifference).value();
+  World diff = boolean(p.a, p.a, BooleanOp::kSubtract).value();
   EXPECT_TRUE(is_valid(diff));
   EXPECT_EQ(total_points(diff), 0u);
   EXPECT_EQ(diff.stats().chunks_solid, 0u);
   EXPECT_TRUE(identical(boolean(p.a, p.a, BooleanOp::kUnion).value(), p.a));
-  EXPECT_TRUE(identical(boolean(p.a, p.a, BooleanOp::kIntersection).value(), p.a));
+  EXPECT_TRUE(identical(boolean(p.a, p.a, BooleanOp::kIntersect).value(), p.a));
 }
 
 TEST(Boolean, EveryNodeFollowsTheOperation) {
   Pair p = spot_and_sphere();
-  for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kDifference, BooleanOp::kIntersection}) {
+  for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kSubtract, BooleanOp::kIntersect}) {
     SCOPED_TRACE(boolean_op_name(op));
     World r = boolean(p.a, p.b, op).value();
     EXPECT_TRUE(is_valid(r));
@@ -127,8 +127,8 @@ TEST(Boolean, VolumesAddUp) {
   for (int axis = 0; axis < 3; ++axis) {
     double va = p.a.volume(axis), vb = p.b.volume(axis);
     double vu = boolean(p.a, p.b, BooleanOp::kUnion).value().volume(axis);
-    double vi = boolean(p.a, p.b, BooleanOp::kIntersection).value().volume(axis);
-    double vd = boolean(p.a, p.b, BooleanOp::kDifference).value().volume(axis);
+    double vi = boolean(p.a, p.b, BooleanOp::kIntersect).value().volume(axis);
+    double vd = boolean(p.a, p.b, BooleanOp::kSubtract).value().volume(axis);
     ASSERT_GT(vi, 0.01 * va);  // the sphere really overlaps spot
     EXPECT_NEAR(vu + vi, va + vb, 1e-4 * va);
     EXPECT_NEAR(vd + vi, va, 1e-4 * va);
@@ -159,7 +159,7 @@ TEST(Boolean, CoplanarCutLeavesNoSlivers) {
   GridConfig grid{.cell_size = 0.1, .chunk_size = 16, .use_origin = true, .origin = glm::dvec3(-0.52, -0.47, -0.55)};
   World a = build_from_mesh(test::box_mesh({0, 0, 0}, {2, 2, 1}), grid).value();
   World b = build_from_mesh(test::box_mesh({0.5, 0.5, 0.5}, {1.5, 1.5, 1}), grid).value();
-  World d = boolean(a, b, BooleanOp::kDifference).value();
+  World d = boolean(a, b, BooleanOp::kSubtract).value();
   ASSERT_TRUE(is_valid(d));
   EXPECT_NEAR(d.volume(2), 4.0 - 0.5, 1e-3);
   // Z rays through the pocket: one span below it, nothing left at the top face.
@@ -167,7 +167,7 @@ TEST(Boolean, CoplanarCutLeavesNoSlivers) {
     auto spans = d.ray_spans(2, {i, i});
     ASSERT_EQ(spans.size(), 1u) << i;
   }
-  EXPECT_TRUE(nodes_follow_op(a, b, d, BooleanOp::kDifference));
+  EXPECT_TRUE(nodes_follow_op(a, b, d, BooleanOp::kSubtract));
 }
 
 TEST(Boolean, CutSurfacesFaceOutAndTakeTheMaterialCut) {
@@ -180,14 +180,14 @@ TEST(Boolean, CutSurfacesFaceOutAndTakeTheMaterialCut) {
   s.material = 9;
   s.transform = glm::translate(glm::dmat4(1.0), glm::dvec3(1.0, 1.0, 2.0));
   World b = detail::rasterize_primitive(s, a.lattice(), a.chunk_size()).value();
-  World d = boolean(a, b, BooleanOp::kDifference).value();
+  World d = boolean(a, b, BooleanOp::kSubtract).value();
   ASSERT_TRUE(is_valid(d));  // includes: every normal points out of the solid
   std::set<uint16_t> materials;
   d.for_each_chunk([&](const glm::ivec3&, ChunkKind, const Chunk* c) {
     if (c) for (const RayFamily& f : c->axis) for (const PackedPoint& p : f.all_points()) materials.insert(p.material);
   });
   EXPECT_EQ(materials, std::set<uint16_t>{5});
-  World tagged = boolean(a, b, BooleanOp::kDifference, {.cut_material = 7}).value();
+  World tagged = boolean(a, b, BooleanOp::kSubtract, {.cut_material = 7}).value();
   materials.clear();
   tagged.for_each_chunk([&](const glm::ivec3&, ChunkKind, const Chunk* c) {
     if (c) for (const RayFamily& f : c->axis) for (const PackedPoint& p : f.all_points()) materials.insert(p.material);
@@ -215,7 +215,7 @@ TEST(Boolean, DisjointIntersectionIsEmptyAndUnionHoldsBoth) {
   GridConfig grid{.cell_size = 0.1, .chunk_size = 8, .use_origin = true, .origin = glm::dvec3(0.013)};
   World a = build_from_mesh(test::box_mesh({0, 0, 0}, {1, 1, 1}), grid).value();
   World b = build_from_mesh(test::box_mesh({5, 5, 5}, {6, 6, 6}), grid).value();
-  World i = boolean(a, b, BooleanOp::kIntersection).value();
+  World i = boolean(a, b, BooleanOp::kIntersect).value();
   EXPECT_TRUE(is_valid(i));
   EXPECT_EQ(total_points(i), 0u);
   World u = boolean(a, b, BooleanOp::kUnion).value();
@@ -228,7 +228,7 @@ TEST(MeshBoolean, OpenBunnyMinusSphereIsValid) {
   MeshBounds bb = mesh_bounds(bunny);
   glm::dvec3 centre = 0.5 * (bb.min + bb.max);
   TriangleMesh ball = test::sphere_mesh(centre + glm::dvec3(0, 0.3 * bb.extent().y, 0), 0.3 * bb.extent().y, 3);
-  for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kDifference, BooleanOp::kIntersection}) {
+  for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kSubtract, BooleanOp::kIntersect}) {
     Result<World> r = mesh_boolean(bunny, ball, op, {.cells = 48, .chunk_size = 16});
     ASSERT_TRUE(r.ok()) << r.status().message();
     EXPECT_TRUE(is_valid(r.value()));
@@ -374,7 +374,7 @@ TEST(Editor, BuildGrowsTheWorldAndSubtractOutsideChangesNothing) {
   Result<EditReceipt> r = ed.apply(Brush::sphere({0, 0, 20.0}, 1.0, 4), EditOp::kSubtract);
   ASSERT_TRUE(r.ok());
   EXPECT_TRUE(r.value().changed_chunks.empty());
-  r = ed.apply(Brush::box({0, 0, 20.0}, glm::dvec3(1.0), 4), EditOp::kAdd);
+  r = ed.apply(Brush::box({0, 0, 20.0}, glm::dvec3(1.0), 4), EditOp::kUnion);
   ASSERT_TRUE(r.ok()) << r.status().message();
   EXPECT_GT(ed.world().chunk_dims().z, dims.z);
   ASSERT_TRUE(is_valid(ed.world()));
@@ -431,7 +431,7 @@ TEST(Editor, UndoRestoresInReverseOrderOnly) {
   WorldEditor ed(original);
   EditReceipt first = ed.apply(Brush::sphere({0.0, 0.0, 1.0}, 1.0), EditOp::kSubtract).value();
   World after_first = ed.world();
-  EditReceipt second = ed.apply(Brush::box({0.5, 0.0, 1.0}, glm::dvec3(0.6)), EditOp::kAdd).value();
+  EditReceipt second = ed.apply(Brush::box({0.5, 0.0, 1.0}, glm::dvec3(0.6)), EditOp::kUnion).value();
   ed.take_dirty();
   // The first edit's chunks were changed again by the second: refused, nothing changes.
   Status s = ed.undo(first);
@@ -450,7 +450,7 @@ TEST(Editor, UndoRestoresInReverseOrderOnly) {
 TEST(Editor, BatchEqualsEditsInOrder) {
   std::vector<WorldEditor::Edit> edits = {
       {Brush::sphere({0.0, 0.0, 1.0}, 1.2), EditOp::kSubtract},
-      {Brush::capsule({-2, -2, 1}, {2, 1, 0.5}, 0.5, 3), EditOp::kAdd},
+      {Brush::capsule({-2, -2, 1}, {2, 1, 0.5}, 0.5, 3), EditOp::kUnion},
       {Brush::box({1.0, 1.0, 1.0}, glm::dvec3(0.7), 6), EditOp::kPaint},
       {Brush::noisy_sphere({-1.0, 1.5, 0.5}, {.radius = 0.9}), EditOp::kSubtract},
   };
@@ -471,7 +471,7 @@ TEST(Editor, ErrorsLeaveTheWorldAsItWas) {
   Result<EditReceipt> r = ed.apply_batch(edits);
   ASSERT_FALSE(r.ok());
   EXPECT_NE(r.status().message().find("edit 1"), std::string::npos) << r.status().message();
-  r = ed.apply(Brush::box({0, 0, 0}, glm::dvec3(1e6)), EditOp::kAdd);  // far too many cells
+  r = ed.apply(Brush::box({0, 0, 0}, glm::dvec3(1e6)), EditOp::kUnion);  // far too many cells
   ASSERT_FALSE(r.ok());
   EXPECT_EQ(r.status().code(), ErrorCode::kTooLarge) << r.status().message();
   EXPECT_EQ(ed.version(), 0u);
@@ -486,7 +486,7 @@ TEST(Editor, DirtyBoxesRemeshExactlyWhatAFreshBuildWould) {
   std::vector<WorldEditor::Edit> edits = {
       {Brush::sphere({0.0, 0.0, 1.0}, 0.7), EditOp::kSubtract},           // inside a chunk ...
       {Brush::sphere({-1.7, -1.7, 1.0}, 0.5, 2), EditOp::kPaint},         // ... and near chunk corners
-      {Brush::box({1.5, 1.55, 1.2}, glm::dvec3(0.4), 3), EditOp::kAdd},
+      {Brush::box({1.5, 1.55, 1.2}, glm::dvec3(0.4), 3), EditOp::kUnion},
       {Brush::noisy_sphere({-1.6, 1.6, 0.9}, {.radius = 0.6}), EditOp::kSubtract},
   };
   // Then small random edits of every kind centred near chunk faces (x, y = -1.7 or 1.5).
@@ -494,7 +494,7 @@ TEST(Editor, DirtyBoxesRemeshExactlyWhatAFreshBuildWould) {
   std::uniform_real_distribution<double> jitter(-0.9, 0.9), unit(0.0, 1.0);
   for (int i = 0; i < 24; ++i) {
     glm::dvec3 c((rng() % 2 ? 1.5 : -1.7) + jitter(rng), (rng() % 2 ? 1.5 : -1.7) + jitter(rng), 1.0 + 0.5 * jitter(rng));
-    EditOp op = std::array{EditOp::kAdd, EditOp::kSubtract, EditOp::kPaint}[rng() % 3];
+    EditOp op = std::array{EditOp::kUnion, EditOp::kSubtract, EditOp::kPaint}[rng() % 3];
     edits.push_back({Brush::sphere(c, 0.1 + 0.5 * unit(rng), uint16_t(rng() % 3)), op});
   }
   size_t chunks = size_t(ed.world().chunk_dims().x) * ed.world().chunk_dims().y * ed.world().chunk_dims().z;
@@ -538,7 +538,7 @@ TEST(ChunkedMeshUpdate, ReportsExactlyTheChunkMeshesWhoseContentChanged) {
   const std::vector<WorldEditor::Edit> edits = {
       {Brush::sphere({0.0, 0.0, 1.0}, 0.7), EditOp::kSubtract},
       {Brush::sphere({-1.7, -1.7, 1.0}, 0.5, 2), EditOp::kPaint},
-      {Brush::box({1.5, 1.55, 1.2}, glm::dvec3(0.4), 3), EditOp::kAdd},
+      {Brush::box({1.5, 1.55, 1.2}, glm::dvec3(0.4), 3), EditOp::kUnion},
   };
   for (const auto& e : edits) {
     const std::vector<ChunkMesh> before = meshes.chunks();
@@ -587,7 +587,7 @@ TEST(ChunkedMeshUpdate, AnEditThatChangesNoSurfaceReportsNothing) {
   ASSERT_TRUE(meshes.build(ed.world()).ok());
   const uint64_t version = meshes.version();
   // Adding solid inside the solid slab changes the rays' nothing.
-  ASSERT_TRUE(ed.apply(Brush::sphere({0.0, 0.0, 0.0}, 0.3, 1), EditOp::kAdd).ok());
+  ASSERT_TRUE(ed.apply(Brush::sphere({0.0, 0.0, 0.0}, 0.3, 1), EditOp::kUnion).ok());
   Result<MeshUpdate> u = meshes.update(ed.world(), ed.take_dirty());
   ASSERT_TRUE(u.ok());
   EXPECT_TRUE(u->changes.empty());
@@ -627,9 +627,9 @@ TEST(EditorProperty, TenThousandRandomEditsStayValid) {
     if (b.shape == Brush::Shape::kPrimitive && rng() % 4 == 0) {  // tilt some
       b.primitive.transform = glm::rotate(b.primitive.transform, 6.28 * unit(rng), glm::dvec3(unit(rng), unit(rng), 0.5));
     }
-    EditOp op = std::array{EditOp::kSubtract, EditOp::kSubtract, EditOp::kAdd, EditOp::kAdd, EditOp::kPaint,
+    EditOp op = std::array{EditOp::kSubtract, EditOp::kSubtract, EditOp::kUnion, EditOp::kUnion, EditOp::kPaint,
                            EditOp::kIntersect}[rng() % 6];
-    if (op == EditOp::kIntersect && rng() % 8 != 0) op = EditOp::kAdd;  // intersect empties most of the world
+    if (op == EditOp::kIntersect && rng() % 8 != 0) op = EditOp::kUnion;  // intersect empties most of the world
     World before = ed.world();
     Result<EditReceipt> r = ed.apply(b, op);
     ASSERT_TRUE(r.ok()) << i << ": " << r.status().message();
@@ -644,7 +644,7 @@ TEST(EditorProperty, TenThousandRandomEditsStayValid) {
     });
     if (i % 16 == 0) {
       double vb = before.volume(0), va = after.volume(0);
-      if (op == EditOp::kAdd) {
+      if (op == EditOp::kUnion) {
         ASSERT_GE(va, vb - 1e-9) << i;
       }
       if (op == EditOp::kSubtract || op == EditOp::kIntersect) {
@@ -658,7 +658,7 @@ TEST(EditorProperty, TenThousandRandomEditsStayValid) {
     nonempty_worlds += after.stats().points > 0;
     receipts.push_back(std::move(r).value());
     if (ed.world().stats().points == 0 && rng() % 2) {  // refill an emptied world now and then
-      ASSERT_TRUE(ed.apply(Brush::box({0, 0, 0}, {2.0, 2.0, 1.0}), EditOp::kAdd).ok());
+      ASSERT_TRUE(ed.apply(Brush::box({0, 0, 0}, {2.0, 2.0, 1.0}), EditOp::kUnion).ok());
       receipts.clear();
     }
   }
@@ -671,6 +671,24 @@ TEST(EditorProperty, TenThousandRandomEditsStayValid) {
     receipts.pop_back();
   }
   EXPECT_TRUE(is_valid(ed.world()));
+}
+
+TEST(OpNames, OneNamePerOperationAndThe02SpellingsStillParse) {
+  EXPECT_STREQ(boolean_op_name(BooleanOp::kSubtract), "subtract");
+  EXPECT_STREQ(boolean_op_name(BooleanOp::kIntersect), "intersect");
+  EXPECT_STREQ(edit_op_name(EditOp::kUnion), "union");
+  EXPECT_STREQ(edit_op_name(EditOp::kSubtract), "subtract");
+  for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kSubtract, BooleanOp::kIntersect}) {
+    EXPECT_EQ(boolean_op_from_name(boolean_op_name(op)), op);
+  }
+  for (EditOp op : {EditOp::kUnion, EditOp::kSubtract, EditOp::kIntersect, EditOp::kPaint}) {
+    EXPECT_EQ(edit_op_from_name(edit_op_name(op)), op);
+  }
+  EXPECT_EQ(boolean_op_from_name("difference"), BooleanOp::kSubtract);
+  EXPECT_EQ(boolean_op_from_name("intersection"), BooleanOp::kIntersect);
+  EXPECT_EQ(edit_op_from_name("add"), EditOp::kUnion);
+  EXPECT_EQ(boolean_op_from_name("xor"), std::nullopt);
+  EXPECT_EQ(edit_op_from_name("dig"), std::nullopt);
 }
 
 }  // namespace

@@ -59,7 +59,7 @@ TEST(LiveWorld, UpdateReportsTheChunkMeshesAnEditChangedAndMatchesAFreshBuild) {
   for (const ChunkMesh& m : live->meshes()->chunks()) uploaded[key(m.chunk)] = m.version;
 
   ASSERT_TRUE(live->apply(Brush::sphere({8.0, 8.0, z}, 1.5), EditOp::kSubtract).ok());
-  ASSERT_TRUE(live->apply(Brush::box({4.0, 4.0, z + 0.5}, glm::dvec3(0.6), kMaterialDirt), EditOp::kAdd).ok());
+  ASSERT_TRUE(live->apply(Brush::box({4.0, 4.0, z + 0.5}, glm::dvec3(0.6), kMaterialDirt), EditOp::kUnion).ok());
   Result<LiveUpdate> u = live->update();
   ASSERT_TRUE(u.ok()) << u.status().message();
   EXPECT_GT(u->dirty_chunks, 0u);

@@ -340,7 +340,7 @@ TEST(Nav, DigOpensAShortcutAndFillClosesIt) {
   EXPECT_NEAR(through.length, 6.0, 1e-3);
   EXPECT_LT(through.length, around - 4.0);
   // Fill it again (a build brush) and the shortcut is gone.
-  ASSERT_TRUE(editor.apply(Brush::box({5.0, 2.0, 1.75}, {0.1, 1.5, 1.25}), EditOp::kAdd).ok());
+  ASSERT_TRUE(editor.apply(Brush::box({5.0, 2.0, 1.75}, {0.1, 1.5, 1.25}), EditOp::kUnion).ok());
   ASSERT_TRUE(nav.update(editor.world(), editor.take_dirty()).ok());
   EXPECT_NEAR(path_of(nav, a, b).length, around, 1e-6);
 }
@@ -352,7 +352,7 @@ TEST(Nav, UpdateFollowsAWorldThatGrew) {
   NavMesh nav = nav_of(world);
   WorldEditor editor(world);
   // A slab continuing the floor eastwards, well past the box.
-  ASSERT_TRUE(editor.apply(Brush::box({14.0, 2.0, 0.625}, {6.1, 1.95, 0.375}), EditOp::kAdd).ok());
+  ASSERT_TRUE(editor.apply(Brush::box({14.0, 2.0, 0.625}, {6.1, 1.95, 0.375}), EditOp::kUnion).ok());
   ASSERT_GT(editor.world().chunk_dims().x, world.chunk_dims().x);
   Result<NavUpdateStats> up = nav.update(editor.world(), editor.take_dirty());
   ASSERT_TRUE(up.ok());
@@ -370,7 +370,7 @@ TEST(Nav, UpdateEqualsRebuildAfterRandomEdits) {
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> x(0.0, 16.0), z(0.5, 2.0), r(0.4, 1.6);
   for (int i = 0; i < 10; ++i) {
-    const EditOp op = i % 3 == 2 ? EditOp::kAdd : EditOp::kSubtract;
+    const EditOp op = i % 3 == 2 ? EditOp::kUnion : EditOp::kSubtract;
     ASSERT_TRUE(editor.apply(Brush::sphere({x(rng), x(rng), z(rng)}, r(rng)), op).ok());
     ASSERT_TRUE(nav.update(editor.world(), editor.take_dirty()).ok());
     const NavMesh fresh = nav_of(editor.world());

@@ -340,7 +340,7 @@ TEST(RayCast, SeesEditsWithoutARebuild) {
   ASSERT_TRUE(editor.undo(dig.value()).ok());
   EXPECT_EQ(queries.ray_cast(ray).value().distance, before);
   // A build that grows the world's box is followed too.
-  ASSERT_TRUE(editor.apply(Brush::sphere(glm::dvec3(0.0, 0.0, 2.4), 0.3), EditOp::kAdd).ok());
+  ASSERT_TRUE(editor.apply(Brush::sphere(glm::dvec3(0.0, 0.0, 2.4), 0.3), EditOp::kUnion).ok());
   EXPECT_NEAR(queries.ray_cast(ray).value().distance, 0.3, 0.01);
   queries.refresh();
   EXPECT_NEAR(queries.ray_cast(ray).value().distance, 0.3, 0.01);
@@ -365,7 +365,7 @@ TEST(RayCast, AfterRandomEditsEqualsAFreshCache) {
     for (const Ray& ray : random_rays(500)) (void)warm.ray_cast(ray);  // derive bits before the edit
     const WorldBox b = editor.world().solid_bounds().value();
     const glm::dvec3 at = b.min + (b.max - b.min) * glm::dvec3(u(rng), u(rng), u(rng));
-    const EditOp op = edit % 3 == 2 ? EditOp::kAdd : EditOp::kSubtract;
+    const EditOp op = edit % 3 == 2 ? EditOp::kUnion : EditOp::kSubtract;
     ASSERT_TRUE(editor.apply(Brush::sphere(at, 0.5 + 2.0 * u(rng), uint16_t(edit)), op).ok());
     if (edit % 4 == 3) warm.refresh();
     Queries fresh(editor.world());

@@ -1,4 +1,4 @@
-// ldc boolean: two meshes -> one lattice -> union, difference or intersection -> mesh.
+// ldc boolean: two meshes -> one lattice -> union, subtract or intersect -> mesh.
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -62,18 +62,16 @@ Status place(const Placement& p, TriangleMesh* mesh) {
 // Why an empty result is empty, for the warning.
 std::string empty_reason(BooleanOp op) {
   switch (op) {
-    case BooleanOp::kIntersection: return "A and B do not overlap on the lattice";
-    case BooleanOp::kDifference: return "B covers all of A on the lattice";
+    case BooleanOp::kIntersect: return "A and B do not overlap on the lattice";
+    case BooleanOp::kSubtract: return "B covers all of A on the lattice";
     case BooleanOp::kUnion: return "neither A nor B holds any solid on the lattice";
   }
   return "no solid is left";
 }
 
 Result<BooleanOp> parse_boolean_op(const std::string& name) {
-  for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kDifference, BooleanOp::kIntersection}) {
-    if (name == boolean_op_name(op)) return op;
-  }
-  return Status(ErrorCode::kInvalidArgument, "--op '" + name + "': use union, difference or intersection");
+  if (std::optional<BooleanOp> op = boolean_op_from_name(name)) return *op;
+  return Status(ErrorCode::kInvalidArgument, "--op '" + name + "': use union, subtract or intersect");
 }
 
 // An input as its build saw it: open inputs are decided by the repair's
@@ -140,10 +138,10 @@ int run_boolean(const BooleanArgs& a, const CommonOptions& common) {
 void add_boolean_command(CLI::App& app, CommonOptions& common) {
   auto args = std::make_shared<BooleanArgs>();
   CLI::App* cmd = app.add_subcommand(
-      "boolean", "Union, difference or intersection of two meshes on one lattice -> mesh, with the quality report");
+      "boolean", "Union, subtraction or intersection of two meshes on one lattice -> mesh, with the quality report");
   cmd->add_option("first", args->first, "Mesh file A (.obj .ply .stl .off)")->required();
   cmd->add_option("second", args->second, "Mesh file B (.obj .ply .stl .off)")->required();
-  cmd->add_option("--op", args->op, "union | difference (A minus B) | intersection")->required();
+  cmd->add_option("--op", args->op, "union | subtract (A minus B) | intersect (0.2's difference and intersection still work)")->required();
   cmd->add_option("--translate-b", args->translate_b,
                   "Move mesh B by x,y,z (m) after --scale-b, before the boolean (default 0,0,0)");
   cmd->add_option("--scale-b", args->scale_b,
@@ -152,7 +150,7 @@ void add_boolean_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--sliver", args->config.sliver, "Remove spans and gaps thinner than this (cells, 0 .. 0.5)")
       ->capture_default_str();
   cmd->add_option("--cut-material", args->config.cut_material,
-                  "Material of surfaces a difference exposes (-1 = the material cut into)")
+                  "Material of surfaces a subtraction exposes (-1 = the material cut into)")
       ->capture_default_str();
   add_mesh_output_options(cmd, args->mesh);
   cmd->callback([args, &common] {

@@ -18,7 +18,7 @@
 namespace ldc::tool {
 
 const char* const kEditScriptHelp = R"(Script (JSON): {"edits": [ edit, ... ]}, applied in order. Every edit has
-  "op": add | subtract | intersect | paint, "brush": one of the below,
+  "op": union | subtract | intersect | paint ("add" = union), "brush": one of the below,
   "material": id 0..65535 (optional, default 0), and the brush's fields:
   sphere    "centre": [x,y,z], "radius": r
   box       "centre": [x,y,z], "half_extents": [x,y,z]
@@ -212,13 +212,6 @@ const BrushKind* find_brush_kind(const std::string& name) {
   return nullptr;
 }
 
-std::optional<EditOp> find_edit_op(const std::string& name) {
-  for (EditOp op : {EditOp::kAdd, EditOp::kSubtract, EditOp::kIntersect, EditOp::kPaint}) {
-    if (name == edit_op_name(op)) return op;
-  }
-  return std::nullopt;
-}
-
 // Refuses fields the brush does not take: a misspelt optional field would
 // otherwise be dropped without a word.
 void refuse_unknown_fields(const nlohmann::json& edit, const BrushKind& kind, EditFields& f) {
@@ -239,9 +232,9 @@ Result<ScriptEdit> read_edit(const nlohmann::json& edit, size_t index, MeshFiles
   }
   EditFields f(edit, index);
   std::string op_name = f.text("op"), brush_name = f.text("brush");
-  std::optional<EditOp> op = find_edit_op(op_name);
+  std::optional<EditOp> op = edit_op_from_name(op_name);
   const BrushKind* kind = find_brush_kind(brush_name);
-  if (!op) f.fail("op", "is '" + op_name + "', not an op (add, subtract, intersect, paint)");
+  if (!op) f.fail("op", "is '" + op_name + "', not an op (union, subtract, intersect, paint)");
   if (!kind) f.fail("brush", "is '" + brush_name + "', not a brush (sphere, box, capsule, cylinder, noise, mesh)");
   if (!f.error().ok()) return f.error();
   refuse_unknown_fields(edit, *kind, f);

@@ -2,13 +2,13 @@
 //
 //   {"edits": [
 //     {"op": "subtract", "brush": "sphere", "centre": [x, y, z], "radius": r},
-//     {"op": "add", "brush": "box", "centre": [..], "half_extents": [..], "material": 2,
+//     {"op": "union", "brush": "box", "centre": [..], "half_extents": [..], "material": 2,
 //      "rotate_deg": 30, "axis": [0, 0, 1]},
 //     {"op": "paint", "brush": "capsule", "a": [..], "b": [..], "radius": r, "material": 3},
 //     {"op": "intersect", "brush": "cylinder", "a": [..], "b": [..], "radius": r},
 //     {"op": "subtract", "brush": "noise", "centre": [..], "radius": r,
 //      "amplitude": 0.25, "frequency": 2, "seed": 1},
-//     {"op": "add", "brush": "mesh", "mesh": "rock.obj", "translate": [..], "scale": 1.0,
+//     {"op": "union", "brush": "mesh", "mesh": "rock.obj", "translate": [..], "scale": 1.0,
 //      "rotate_deg": 0, "axis": [0, 0, 1], "material": 1}
 //   ]}
 //

@@ -118,7 +118,7 @@ double apply_edit(Session& s, int frame) {
   const ldc::Brush brush = frame % 5 == 4
                                ? ldc::Brush::box(p + glm::dvec3(0.0, 2.5, 0.8), {0.5, 0.5, 1.2}, ldc::kMaterialDirt)
                                : ldc::Brush::sphere(p, 1.2);
-  const ldc::EditOp op = frame % 5 == 4 ? ldc::EditOp::kAdd : ldc::EditOp::kSubtract;
+  const ldc::EditOp op = frame % 5 == 4 ? ldc::EditOp::kUnion : ldc::EditOp::kSubtract;
   const Clock::time_point start = Clock::now();
   ldc::Result<ldc::EditReceipt> r = s.live.apply(brush, op);
   const double ms = ms_since(start);

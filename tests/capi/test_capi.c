@@ -135,7 +135,7 @@ static void dig_build_and_paint_change_the_solid(ldc_world* w) {
   dig.centre[0] = 8.0, dig.centre[1] = 8.0, dig.centre[2] = gz;
   dig.radius = 1.5;
   ldc_edit_result r;
-  CHECK_STATUS(ldc_world_edit(w, &dig, LDC_EDIT_DIG, &r), LDC_OK);
+  CHECK_STATUS(ldc_world_edit(w, &dig, LDC_EDIT_SUBTRACT, &r), LDC_OK);
   CHECK(r.version == 1 && r.chunks_changed > 0);
   CHECK(ldc_world_inside(w, below) == 0);
 
@@ -144,7 +144,7 @@ static void dig_build_and_paint_change_the_solid(ldc_world* w) {
   box.centre[0] = 4.0, box.centre[1] = 4.0, box.centre[2] = gz + 6.0;
   box.half_extents[0] = box.half_extents[1] = box.half_extents[2] = 0.6;
   box.material = 2;
-  CHECK_STATUS(ldc_world_edit(w, &box, LDC_EDIT_BUILD, NULL), LDC_OK);
+  CHECK_STATUS(ldc_world_edit(w, &box, LDC_EDIT_BUILD, NULL), LDC_OK); /* the 0.2 spelling of LDC_EDIT_UNION */
   CHECK(ldc_world_inside(w, box.centre) == 1);
 
   ldc_brush paint = {0};
@@ -167,11 +167,11 @@ static void bad_brush_leaves_the_world_unchanged(ldc_world* w) {
   ldc_brush b = {0};
   b.shape = LDC_BRUSH_SPHERE;
   b.radius = -1.0;
-  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_DIG, NULL), LDC_INVALID_ARGUMENT);
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_SUBTRACT, NULL), LDC_INVALID_ARGUMENT);
   CHECK(strstr(ldc_last_error(), "radius") != NULL);
   b.radius = 1.0;
   b.shape = (ldc_brush_shape)7;
-  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_DIG, NULL), LDC_INVALID_ARGUMENT);
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_SUBTRACT, NULL), LDC_INVALID_ARGUMENT);
   CHECK(strstr(ldc_last_error(), "brush shape 7") != NULL);
   b.shape = LDC_BRUSH_SPHERE;
   CHECK_STATUS(ldc_world_edit(w, &b, (ldc_edit_op)9, NULL), LDC_INVALID_ARGUMENT);
@@ -256,7 +256,7 @@ static void chunk_meshes_follow_the_edits(ldc_world* w) {
   b.shape = LDC_BRUSH_SPHERE;
   b.centre[0] = 12.0, b.centre[1] = 4.0, b.centre[2] = ground_z(w, 12.0, 4.0) + 3.0;
   b.radius = 1.2;
-  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_BUILD, NULL), LDC_OK); /* a floating ball: more triangles */
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_UNION, NULL), LDC_OK); /* a floating ball: more triangles */
   const size_t after = mesh_every_chunk(w);
   CHECK(after > before);
   const int32_t outside[3] = {1000, 0, 0};
@@ -310,7 +310,7 @@ static void changed_meshes_are_flagged_dirty(ldc_world* w) {
   b.centre[0] = 8.0, b.centre[1] = 8.0, b.centre[2] = ground_z(w, 8.5, 8.5);
   b.radius = 1.0;
   b.material = 1;
-  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_BUILD, NULL), LDC_OK);
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_UNION, NULL), LDC_OK);
   ldc_world_take_dirty(w, NULL, 0, &n);
   ldc_dirty_chunk* dirty = calloc(n + 1, sizeof *dirty);
   CHECK_STATUS(ldc_world_take_dirty(w, dirty, n, &n), LDC_OK);
@@ -382,7 +382,7 @@ static void paths_cross_the_landscape(ldc_world* w) {
   pit.centre[0] = to[0], pit.centre[1] = to[1], pit.centre[2] = to[2] - 3.0;
   pit.half_extents[0] = pit.half_extents[1] = 3.0;
   pit.half_extents[2] = 12.0;
-  CHECK_STATUS(ldc_world_edit(w, &pit, LDC_EDIT_DIG, NULL), LDC_OK);
+  CHECK_STATUS(ldc_world_edit(w, &pit, LDC_EDIT_SUBTRACT, NULL), LDC_OK);
   ldc_path_info after;
   const ldc_status s = ldc_world_find_path(w, from, to, NULL, 0, &after);
   CHECK(s == LDC_NOT_FOUND || (s == LDC_OK && after.status != LDC_PATH_COMPLETE));
@@ -420,7 +420,7 @@ static void cascades_voxelize_a_level(ldc_world* w) {
   b.shape = LDC_BRUSH_SPHERE;
   b.centre[0] = camera[0], b.centre[1] = camera[1], b.centre[2] = camera[2];
   b.radius = 2.0;
-  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_DIG, NULL), LDC_OK);
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_SUBTRACT, NULL), LDC_OK);
   CHECK_STATUS(ldc_cascades_update_level(cas, 0, camera, &u), LDC_OK);
   CHECK(u.full == 0 && u.voxels > 0);
   free(g.occupancy);
