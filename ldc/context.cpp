@@ -8,12 +8,6 @@ void Context::report_progress(std::string_view stage, double fraction) {
   progress_(stage, fraction < 0.0 ? 0.0 : (fraction > 1.0 ? 1.0 : fraction));
 }
 
-void Context::log(std::string_view message) {
-  if (!log_) return;
-  std::lock_guard<std::mutex> lock(mutex_);
-  log_(message);
-}
-
 std::map<std::string, double> Context::timers() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return timers_;

@@ -1,8 +1,9 @@
-// Context: progress, cancellation, logging and per-stage timers for long calls.
+// Context: progress, cancellation and per-stage timers for long calls.
 //
 // Pass a Context* to any long-running call (nullptr is always allowed). The
-// command-line progress bar and the benchmarks read it. Callbacks may be called
-// from worker threads, but never concurrently with each other for one Context.
+// command-line tool draws its progress bar from it and reports its stage
+// timers (`--json`: seconds.stages). The progress callback may be called
+// from worker threads, but never concurrently with itself for one Context.
 #pragma once
 
 #include <atomic>
@@ -19,10 +20,8 @@ class Context {
  public:
   // fraction in [0, 1] of the named stage.
   using ProgressFn = std::function<void(std::string_view stage, double fraction)>;
-  using LogFn = std::function<void(std::string_view message)>;
 
   void set_progress(ProgressFn fn) { progress_ = std::move(fn); }
-  void set_log(LogFn fn) { log_ = std::move(fn); }
 
   // Request that the running call stops at its next checkpoint; it then
   // returns ErrorCode::kCancelled and leaves its outputs untouched.
@@ -30,16 +29,15 @@ class Context {
   bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
 
   void report_progress(std::string_view stage, double fraction);
-  void log(std::string_view message);
 
-  // Seconds accumulated per stage name since construction or clear_timers().
+  // Seconds accumulated per stage name since construction or clear_timers():
+  // "build.rasterize", "build.votes", "contour", "edit", "voxelize", ...
   std::map<std::string, double> timers() const;
   void add_time(const std::string& stage, double seconds);
   void clear_timers();
 
  private:
   ProgressFn progress_;
-  LogFn log_;
   std::atomic<bool> cancelled_{false};
   mutable std::mutex mutex_;
   std::map<std::string, double> timers_;

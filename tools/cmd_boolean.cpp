@@ -129,7 +129,7 @@ int run_boolean(const BooleanArgs& a, const CommonOptions& common) {
       {"op", a.op},
       {"empty", empty},
       {"inputs", nlohmann::json::array({input_json(a.first, first.value(), builds[0]), input_json(a.second, second.value(), builds[1])})},
-      {"seconds", {{"load", load}, {"build_boolean", b.seconds()}}}};
+      {"seconds", {{"load", load}, {"build_boolean", b.seconds()}, {"stages", stage_seconds(*bar.context())}}}};
   return contour_and_report("boolean", w.value(), a.mesh, bar, std::move(report), common, print_inputs);
 }
 

@@ -115,6 +115,7 @@ int run_build(const BuildArgs& a, const CommonOptions& common) {
   if (!s.ok()) return fail("build", s);
   nlohmann::json out = {{"output", a.output}, {"build", report_json(report)},
                         {"info", world_info_json(w.value(), a.validate)}};
+  out["build"]["stages"] = stage_seconds(*bar.context());
   if (common.json) {
     std::printf("%s\n", out.dump(2).c_str());
   } else {

@@ -136,6 +136,7 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   ScopedTimer save(nullptr, "");
   s = save_world(live.world(), a.output, {}, bar.context());
   report["seconds"]["save"] = save.seconds();
+  report["seconds"]["stages"] = stage_seconds(*bar.context());
   bar.finish();
   if (!s.ok()) return fail("edit", s);
   report["version"] = live.version();

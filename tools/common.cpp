@@ -157,7 +157,15 @@ std::string world_info_text(const nlohmann::json& j) {
 }
 
 void print_seconds(const nlohmann::json& seconds) {
-  for (const auto& [stage, s] : seconds.items()) std::printf("  %s: %.3f s\n", stage.c_str(), s.get<double>());
+  for (const auto& [stage, s] : seconds.items()) {
+    if (s.is_number()) std::printf("  %s: %.3f s\n", stage.c_str(), s.get<double>());
+  }
+}
+
+nlohmann::json stage_seconds(const Context& ctx) {
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [stage, s] : ctx.timers()) out[stage] = s;
+  return out;
 }
 
 void set_thread_count(int threads) {

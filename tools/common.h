@@ -84,6 +84,8 @@ std::string validation_text(const nlohmann::json& validation);
 
 // "  <stage>: <seconds> s", one line per entry of a {"stage": seconds} object.
 void print_seconds(const nlohmann::json& seconds);
+// The library's stage timers a Context gathered (Context::timers), for --json.
+nlohmann::json stage_seconds(const Context& ctx);
 
 // Limits the TBB worker threads for the rest of the process (0 = all).
 void set_thread_count(int threads);
