@@ -176,6 +176,12 @@ Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk, con
   return std::move(r.value().front());
 }
 
+Result<ChunkedMesh> ChunkedMesh::create(const World& world, const ContourConfig& config, Context* ctx) {
+  ChunkedMesh mesh(config);
+  if (Status s = mesh.build(world, ctx); !s.ok()) return s;
+  return mesh;
+}
+
 Status ChunkedMesh::build(const World& world, Context* ctx) {
   Status s = check_contour_config(config_);
   if (!s.ok()) return s;

@@ -175,6 +175,10 @@ Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk,
 // Keeps one mesh per chunk and re-meshes only the chunks it is told changed.
 class ChunkedMesh {
  public:
+  // Checks the config and meshes every chunk of the world (in parallel): the
+  // way to make one. (An empty ChunkedMesh(config) followed by build() is
+  // the same in two steps.)
+  static Result<ChunkedMesh> create(const World& world, const ContourConfig& config = {}, Context* ctx = nullptr);
   explicit ChunkedMesh(ContourConfig config = {}) : config_(config) {}
   // Meshes every chunk of the world (in parallel).
   Status build(const World& world, Context* ctx = nullptr);

@@ -153,6 +153,9 @@ struct EditReceipt {
 // call runs in parallel over chunks.
 class WorldEditor {
  public:
+  // Checks the config and takes the world: the way to make one.
+  static Result<WorldEditor> create(World world, const BooleanConfig& config = {});
+  // The same without the config check (a bad config fails at the first edit).
   explicit WorldEditor(World world, BooleanConfig config = {});
 
   const World& world() const { return world_; }

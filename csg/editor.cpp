@@ -162,6 +162,11 @@ std::optional<EditOp> edit_op_from_name(std::string_view name) {
 
 WorldEditor::WorldEditor(World world, BooleanConfig config) : world_(std::move(world)), config_(config) {}
 
+Result<WorldEditor> WorldEditor::create(World world, const BooleanConfig& config) {
+  if (Status s = check_boolean_config(config); !s.ok()) return s;
+  return WorldEditor(std::move(world), config);
+}
+
 Result<EditReceipt> WorldEditor::apply(const Brush& brush, EditOp op, Context* ctx) {
   return apply_batch({Edit{brush, op}}, ctx);
 }

@@ -229,10 +229,10 @@ size_t LiveWorld::pending_changes() const { return state_->changes.size(); }
 
 Status LiveWorld::enable_meshes(const ContourConfig& config, Context* ctx) {
   detail::LiveState& s = *state_;
-  ChunkedMesh built(config);
-  if (Status st = built.build(s.world(), ctx); !st.ok()) return st;
-  s.note_rebuild(s.meshes ? &*s.meshes : nullptr, &built);
-  s.meshes.emplace(std::move(built));
+  Result<ChunkedMesh> built = ChunkedMesh::create(s.world(), config, ctx);
+  if (!built) return built.status();
+  s.note_rebuild(s.meshes ? &*s.meshes : nullptr, &*built);
+  s.meshes.emplace(std::move(built).value());
   s.mesh_pending.clear();
   s.config.contour = config;
   s.config.meshes = true;

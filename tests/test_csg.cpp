@@ -691,5 +691,26 @@ TEST(OpNames, OneNamePerOperationAndThe02SpellingsStillParse) {
   EXPECT_EQ(edit_op_from_name("dig"), std::nullopt);
 }
 
+TEST(WorldEditor, CreateRefusesABadConfigByName) {
+  Result<WorldEditor> bad = WorldEditor::create(ground(), {.sliver = 0.9});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_NE(bad.status().message().find("sliver"), std::string::npos) << bad.status().message();
+  Result<WorldEditor> good = WorldEditor::create(ground());
+  ASSERT_TRUE(good.ok());
+  EXPECT_TRUE(good->apply(Brush::sphere({0.0, 0.0, 1.0}, 0.5), EditOp::kSubtract).ok());
+}
+
+TEST(ChunkedMesh, CreateEqualsBuildAndRefusesABadConfig) {
+  const World w = ground();
+  Result<ChunkedMesh> made = ChunkedMesh::create(w);
+  ASSERT_TRUE(made.ok());
+  ChunkedMesh built;
+  ASSERT_TRUE(built.build(w).ok());
+  EXPECT_TRUE(test::same_chunk_meshes(*made, built));
+  Result<ChunkedMesh> bad = ChunkedMesh::create(w, {.iterations = -1});
+  ASSERT_FALSE(bad.ok());
+  EXPECT_EQ(bad.status().code(), ErrorCode::kInvalidArgument);
+}
+
 }  // namespace
 }  // namespace ldc
