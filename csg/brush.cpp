@@ -10,14 +10,11 @@
 namespace ldc {
 namespace {
 
-Brush primitive_brush(Primitive::Shape shape, const glm::dmat4& transform, uint16_t material) {
-  Brush b;
-  b.shape = Brush::Shape::kPrimitive;
-  b.primitive.shape = shape;
-  b.primitive.transform = transform;
-  b.primitive.material = material;
-  b.material = material;
-  return b;
+Primitive placed_primitive(Primitive::Shape shape, const glm::dmat4& transform) {
+  Primitive p;
+  p.shape = shape;
+  p.transform = transform;
+  return p;
 }
 
 // A frame whose z axis runs from a to b, centred between them.
@@ -44,86 +41,93 @@ bool finite_matrix(const glm::dmat4& m) {
 
 }  // namespace
 
+glm::dmat4& Brush::transform() {
+  return std::visit([](auto& shape) -> glm::dmat4& { return shape.transform; }, shape);
+}
+
+const glm::dmat4& Brush::transform() const {
+  return std::visit([](const auto& shape) -> const glm::dmat4& { return shape.transform; }, shape);
+}
+
 Brush Brush::sphere(const glm::dvec3& centre, double radius, uint16_t material) {
-  Brush b = primitive_brush(Primitive::Shape::kSphere, glm::translate(glm::dmat4(1.0), centre), material);
-  b.primitive.radius = radius;
-  return b;
+  Primitive p = placed_primitive(Primitive::Shape::kSphere, glm::translate(glm::dmat4(1.0), centre));
+  p.radius = radius;
+  return {p, material};
 }
 
 Brush Brush::box(const glm::dvec3& centre, const glm::dvec3& half_extents, uint16_t material) {
-  Brush b = primitive_brush(Primitive::Shape::kBox, glm::translate(glm::dmat4(1.0), centre), material);
-  b.primitive.half_extents = half_extents;
-  return b;
+  Primitive p = placed_primitive(Primitive::Shape::kBox, glm::translate(glm::dmat4(1.0), centre));
+  p.half_extents = half_extents;
+  return {p, material};
 }
 
 Brush Brush::capsule(const glm::dvec3& a, const glm::dvec3& c, double radius, uint16_t material) {
-  Brush b = primitive_brush(Primitive::Shape::kCapsule, segment_frame(a, c), material);
-  b.primitive.radius = radius;
-  b.primitive.half_height = std::max(0.5 * glm::length(c - a), 1e-9);
-  return b;
+  Primitive p = placed_primitive(Primitive::Shape::kCapsule, segment_frame(a, c));
+  p.radius = radius;
+  p.half_height = std::max(0.5 * glm::length(c - a), 1e-9);
+  return {p, material};
 }
 
 Brush Brush::cylinder(const glm::dvec3& a, const glm::dvec3& c, double radius, uint16_t material) {
-  Brush b = primitive_brush(Primitive::Shape::kCylinder, segment_frame(a, c), material);
-  b.primitive.radius = radius;
-  b.primitive.half_height = 0.5 * glm::length(c - a);
-  return b;
+  Primitive p = placed_primitive(Primitive::Shape::kCylinder, segment_frame(a, c));
+  p.radius = radius;
+  p.half_height = 0.5 * glm::length(c - a);
+  return {p, material};
 }
 
 Brush Brush::noisy_sphere(const glm::dvec3& centre, const NoiseSphere& noise, uint16_t material) {
-  Brush b;
-  b.shape = Shape::kNoise;
-  b.noise = noise;
-  b.transform = glm::translate(glm::dmat4(1.0), centre);
-  b.material = material;
-  return b;
+  return {NoiseShape{noise, glm::translate(glm::dmat4(1.0), centre)}, material};
 }
 
 Brush Brush::from_mesh(std::shared_ptr<const TriangleMesh> mesh, const glm::dmat4& transform, uint16_t material) {
-  Brush b;
-  b.shape = Shape::kMesh;
-  b.mesh = std::move(mesh);
-  b.transform = transform;
-  b.material = material;
-  return b;
+  return {MeshShape{std::move(mesh), transform}, material};
 }
 
-Status check_brush(const Brush& b) {
-  switch (b.shape) {
-    case Brush::Shape::kPrimitive: return check_primitive(b.primitive);
-    case Brush::Shape::kMesh:
-      if (!b.mesh) return {ErrorCode::kInvalidArgument, "brush: mesh brush without a mesh"};
-      if (!finite_matrix(b.transform) || glm::determinant(glm::dmat3(b.transform)) == 0.0) {
-        return {ErrorCode::kInvalidArgument, "brush: mesh transform is not finite and invertible"};
-      }
-      return check_mesh(*b.mesh, "brush mesh");
-    case Brush::Shape::kNoise: {
-      const NoiseSphere& n = b.noise;
-      if (!(n.radius > 0.0) || !std::isfinite(n.radius)) {
-        return {ErrorCode::kInvalidArgument, "brush: noise radius = " + std::to_string(n.radius) + " must be > 0"};
-      }
-      if (!(n.amplitude >= 0.0 && n.amplitude <= 0.9)) {
-        return {ErrorCode::kInvalidArgument, "brush: noise amplitude = " + std::to_string(n.amplitude) + " must be in 0 .. 0.9"};
-      }
-      if (!(n.frequency > 0.0 && n.frequency <= 64.0)) {
-        return {ErrorCode::kInvalidArgument, "brush: noise frequency = " + std::to_string(n.frequency) + " must be in (0, 64]"};
-      }
-      if (!finite_matrix(b.transform)) return {ErrorCode::kInvalidArgument, "brush: transform is not finite"};
-      return {};
-    }
+namespace {
+
+Status check_shape(const Primitive& p) { return check_primitive(p); }
+
+Status check_shape(const MeshShape& m) {
+  if (!m.mesh) return {ErrorCode::kInvalidArgument, "brush: mesh brush without a mesh"};
+  if (!finite_matrix(m.transform) || glm::determinant(glm::dmat3(m.transform)) == 0.0) {
+    return {ErrorCode::kInvalidArgument, "brush: mesh transform is not finite and invertible"};
   }
-  return {ErrorCode::kInvalidArgument, "brush: unknown shape"};
+  return check_mesh(*m.mesh, "brush mesh");
+}
+
+Status check_shape(const NoiseShape& s) {
+  const NoiseSphere& n = s.noise;
+  if (!(n.radius > 0.0) || !std::isfinite(n.radius)) {
+    return {ErrorCode::kInvalidArgument, "brush: noise radius = " + std::to_string(n.radius) + " must be > 0"};
+  }
+  if (!(n.amplitude >= 0.0 && n.amplitude <= 0.9)) {
+    return {ErrorCode::kInvalidArgument, "brush: noise amplitude = " + std::to_string(n.amplitude) + " must be in 0 .. 0.9"};
+  }
+  if (!(n.frequency > 0.0 && n.frequency <= 64.0)) {
+    return {ErrorCode::kInvalidArgument, "brush: noise frequency = " + std::to_string(n.frequency) + " must be in (0, 64]"};
+  }
+  if (!finite_matrix(s.transform)) return {ErrorCode::kInvalidArgument, "brush: transform is not finite"};
+  return {};
+}
+
+}  // namespace
+
+Status check_brush(const Brush& b) {
+  return std::visit([](const auto& shape) { return check_shape(shape); }, b.shape);
 }
 
 Result<World> rasterize_brush(const Brush& brush, const Lattice& lattice, int chunk_size) {
   Status s = check_brush(brush);
   if (!s.ok()) return s;
-  switch (brush.shape) {
-    case Brush::Shape::kPrimitive: return detail::rasterize_primitive(brush.primitive, lattice, chunk_size);
-    case Brush::Shape::kNoise: return detail::rasterize_noise_sphere(brush, lattice, chunk_size);
-    case Brush::Shape::kMesh: return detail::rasterize_mesh_brush(brush, lattice, chunk_size);
+  if (const Primitive* p = std::get_if<Primitive>(&brush.shape)) {
+    Primitive with_material = *p;
+    with_material.material = brush.material;
+    return detail::rasterize_primitive(with_material, lattice, chunk_size);
   }
-  return Status(ErrorCode::kInvalidArgument, "brush: unknown shape");
+  if (const NoiseShape* n = std::get_if<NoiseShape>(&brush.shape)) {
+    return detail::rasterize_noise_sphere(*n, brush.material, lattice, chunk_size);
+  }
+  return detail::rasterize_mesh_brush(std::get<MeshShape>(brush.shape), brush.material, lattice, chunk_size);
 }
 
 }  // namespace ldc

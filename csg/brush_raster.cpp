@@ -148,12 +148,12 @@ std::shared_ptr<const NoiseTable> noise_table(double frequency, uint32_t seed) {
 // star-shaped solid, so every radial line crosses its surface once.
 class NoiseSphereSolid final : public ImplicitSolid {
  public:
-  explicit NoiseSphereSolid(const Brush& b)
-      : n_(b.noise),
-        table_(noise_table(b.noise.frequency, b.noise.seed)),
-        transform_(b.transform),
-        inverse_(glm::inverse(b.transform)),
-        material_(b.material) {}
+  NoiseSphereSolid(const NoiseShape& s, uint16_t material)
+      : n_(s.noise),
+        table_(noise_table(s.noise.frequency, s.noise.seed)),
+        transform_(s.transform),
+        inverse_(glm::inverse(s.transform)),
+        material_(material) {}
 
   double value(const glm::dvec3& world) const override {
     glm::dvec3 l(inverse_ * glm::dvec4(world, 1.0));
@@ -202,29 +202,30 @@ GridConfig aligned_grid(const Lattice& lattice, int chunk_size) {
   return g;
 }
 
-std::unique_ptr<ImplicitSolid> make_noise_sphere_solid(const Brush& brush) {
-  return std::make_unique<NoiseSphereSolid>(brush);
+std::unique_ptr<ImplicitSolid> make_noise_sphere_solid(const NoiseShape& shape, uint16_t material) {
+  return std::make_unique<NoiseSphereSolid>(shape, material);
 }
 
 Result<World> rasterize_primitive(const Primitive& primitive, const Lattice& lattice, int chunk_size) {
   return build_from_implicit(*make_primitive_solid(primitive), aligned_grid(lattice, chunk_size));
 }
 
-Result<World> rasterize_noise_sphere(const Brush& brush, const Lattice& lattice, int chunk_size) {
-  return build_from_implicit(NoiseSphereSolid(brush), aligned_grid(lattice, chunk_size));
+Result<World> rasterize_noise_sphere(const NoiseShape& shape, uint16_t material, const Lattice& lattice,
+                                    int chunk_size) {
+  return build_from_implicit(NoiseSphereSolid(shape, material), aligned_grid(lattice, chunk_size));
 }
 
-Result<World> rasterize_mesh_brush(const Brush& brush, const Lattice& lattice, int chunk_size) {
+Result<World> rasterize_mesh_brush(const MeshShape& shape, uint16_t material, const Lattice& lattice, int chunk_size) {
   TriangleMesh placed;
-  placed.positions.reserve(brush.mesh->positions.size());
-  for (const glm::dvec3& p : brush.mesh->positions) {
-    placed.positions.emplace_back(brush.transform * glm::dvec4(p, 1.0));
+  placed.positions.reserve(shape.mesh->positions.size());
+  for (const glm::dvec3& p : shape.mesh->positions) {
+    placed.positions.emplace_back(shape.transform * glm::dvec4(p, 1.0));
   }
-  placed.triangles = brush.mesh->triangles;
-  if (glm::determinant(glm::dmat3(brush.transform)) < 0.0) {  // a mirror turns the faces inside out
+  placed.triangles = shape.mesh->triangles;
+  if (glm::determinant(glm::dmat3(shape.transform)) < 0.0) {  // a mirror turns the faces inside out
     for (glm::uvec3& t : placed.triangles) std::swap(t.y, t.z);
   }
-  placed.triangle_material.assign(placed.triangles.size(), brush.material);
+  placed.triangle_material.assign(placed.triangles.size(), material);
   return build_from_mesh(placed, aligned_grid(lattice, chunk_size));
 }
 

@@ -37,6 +37,7 @@
 #include <optional>
 #include <string_view>
 #include <unordered_map>
+#include <variant>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -102,14 +103,29 @@ struct NoiseSphere {
   uint32_t seed = 1;
 };
 
+// A triangle mesh placed by `transform` (local -> world).
+struct MeshShape {
+  std::shared_ptr<const TriangleMesh> mesh;
+  glm::dmat4 transform{1.0};
+};
+
+// A noisy sphere centred at `transform`'s origin (local -> world).
+struct NoiseShape {
+  NoiseSphere noise;
+  glm::dmat4 transform{1.0};
+};
+
+// A brush is one shape and the material of what it adds or paints. A new
+// kind of brush is one more alternative of `shape`, one case in check_brush
+// and one in rasterize_brush.
 struct Brush {
-  enum class Shape { kPrimitive, kMesh, kNoise };
-  Shape shape = Shape::kPrimitive;
-  Primitive primitive;                       // kPrimitive (its own transform and material)
-  std::shared_ptr<const TriangleMesh> mesh;  // kMesh: the mesh, placed by `transform`
-  NoiseSphere noise;                         // kNoise: centred at `transform`'s origin
-  glm::dmat4 transform{1.0};                 // kMesh, kNoise: local -> world
-  uint16_t material = 0;                     // kMesh, kNoise: material of what it adds or paints
+  std::variant<Primitive, MeshShape, NoiseShape> shape;  // a Primitive is placed by its own transform
+  uint16_t material = 0;  // (a Primitive's own material field is not read)
+
+  // The shape's local -> world transform, whichever the shape: compose a
+  // rotation or a move with it.
+  glm::dmat4& transform();
+  const glm::dmat4& transform() const;
 
   static Brush sphere(const glm::dvec3& centre, double radius, uint16_t material = 0);
   static Brush box(const glm::dvec3& centre, const glm::dvec3& half_extents, uint16_t material = 0);

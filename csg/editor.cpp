@@ -64,7 +64,7 @@ Result<PreparedEdit> prepare_edit(const WorldEditor::Edit& e, const World& world
   PreparedEdit p;
   p.brush = std::move(raster).value();
   p.op = e.op;
-  p.material = e.brush.shape == Brush::Shape::kPrimitive ? e.brush.primitive.material : e.brush.material;
+  p.material = e.brush.material;
   glm::ivec3 lo(INT32_MAX), hi(INT32_MIN);
   p.brush.for_each_chunk([&](const glm::ivec3& c, ChunkKind kind, const Chunk*) {
     if (kind == ChunkKind::kEmpty) return;

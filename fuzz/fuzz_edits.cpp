@@ -68,8 +68,8 @@ ldc::Brush read_brush(Bytes& in) {
       brush = ldc::Brush::noisy_sphere(a, n, material);
     }
   }
-  if (brush.shape == ldc::Brush::Shape::kPrimitive && in.byte() % 4 == 0) {
-    brush.primitive.transform = glm::rotate(brush.primitive.transform, in.byte() * 0.05, glm::dvec3(1.0, 0.5, 0.25));
+  if (std::holds_alternative<ldc::Primitive>(brush.shape) && in.byte() % 4 == 0) {
+    brush.transform() = glm::rotate(brush.transform(), in.byte() * 0.05, glm::dvec3(1.0, 0.5, 0.25));
   }
   return brush;
 }

@@ -289,7 +289,7 @@ TEST(Brush, RasterizedBrushesAreValidAndHaveTheirVolume) {
 TEST(Brush, NoiseBrushIsContinuousAcrossCubeMapSeams) {
   for (double frequency : {0.7, 2.0, 9.0}) {
     NoiseSphere n{.radius = 1.0, .amplitude = 0.5, .frequency = frequency, .seed = 5};
-    auto solid = detail::make_noise_sphere_solid(Brush::noisy_sphere({0, 0, 0}, n));
+    auto solid = detail::make_noise_sphere_solid(std::get<NoiseShape>(Brush::noisy_sphere({0, 0, 0}, n).shape));
     double largest_jump = 0.0, largest_variation = 0.0, previous = NAN;
     for (int axis = 0; axis < 3; ++axis) {
       for (double sa : {-1.0, 1.0}) {
@@ -624,8 +624,8 @@ TEST(EditorProperty, TenThousandRandomEditsStayValid) {
       case 3: b = Brush::cylinder(centre(), centre(), radius(), uint16_t(rng() % 4)); break;
       default: b = Brush::noisy_sphere(centre(), {.radius = radius(), .amplitude = 0.4 * unit(rng), .seed = uint32_t(i % 16)}, 2);
     }
-    if (b.shape == Brush::Shape::kPrimitive && rng() % 4 == 0) {  // tilt some
-      b.primitive.transform = glm::rotate(b.primitive.transform, 6.28 * unit(rng), glm::dvec3(unit(rng), unit(rng), 0.5));
+    if (std::holds_alternative<Primitive>(b.shape) && rng() % 4 == 0) {  // tilt some
+      b.transform() = glm::rotate(b.transform(), 6.28 * unit(rng), glm::dvec3(unit(rng), unit(rng), 0.5));
     }
     EditOp op = std::array{EditOp::kSubtract, EditOp::kSubtract, EditOp::kUnion, EditOp::kUnion, EditOp::kPaint,
                            EditOp::kIntersect}[rng() % 6];

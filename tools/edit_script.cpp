@@ -146,7 +146,7 @@ Brush sphere_brush(EditFields& f, uint16_t material, MeshFiles&) {
   glm::dvec3 centre = f.vec3("centre");
   double radius = f.number("radius");
   Brush b = Brush::sphere(centre, radius, material);
-  b.primitive.transform = b.primitive.transform * rotation(f);
+  b.transform() = b.transform() * rotation(f);
   return b;
 }
 
@@ -154,7 +154,7 @@ Brush box_brush(EditFields& f, uint16_t material, MeshFiles&) {
   glm::dvec3 centre = f.vec3("centre");
   glm::dvec3 half_extents = f.vec3("half_extents");
   Brush b = Brush::box(centre, half_extents, material);
-  b.primitive.transform = b.primitive.transform * rotation(f);
+  b.transform() = b.transform() * rotation(f);
   return b;
 }
 
@@ -176,7 +176,7 @@ Brush noise_brush(EditFields& f, uint16_t material, MeshFiles&) {
   noise.frequency = f.number_or("frequency", noise.frequency);
   noise.seed = f.integer_or("seed", noise.seed, UINT32_MAX);
   Brush b = Brush::noisy_sphere(centre, noise, material);
-  b.transform = b.transform * rotation(f);
+  b.transform() = b.transform() * rotation(f);
   return b;
 }
 

@@ -10,10 +10,10 @@ namespace ldc::detail {
 GridConfig aligned_grid(const Lattice& lattice, int chunk_size);
 
 Result<World> rasterize_primitive(const Primitive& primitive, const Lattice& lattice, int chunk_size);
-Result<World> rasterize_noise_sphere(const Brush& brush, const Lattice& lattice, int chunk_size);
-Result<World> rasterize_mesh_brush(const Brush& brush, const Lattice& lattice, int chunk_size);
+Result<World> rasterize_noise_sphere(const NoiseShape& shape, uint16_t material, const Lattice& lattice, int chunk_size);
+Result<World> rasterize_mesh_brush(const MeshShape& shape, uint16_t material, const Lattice& lattice, int chunk_size);
 
 // The noise sphere as an implicit solid (for tests and the rasterizer).
-std::unique_ptr<ImplicitSolid> make_noise_sphere_solid(const Brush& brush);
+std::unique_ptr<ImplicitSolid> make_noise_sphere_solid(const NoiseShape& shape, uint16_t material = 0);
 
 }  // namespace ldc::detail
