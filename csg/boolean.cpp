@@ -103,8 +103,21 @@ Result<World> boolean(const World& a, const World& b, BooleanOp op, const Boolea
   return out;
 }
 
+Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid) {
+  return mesh_boolean(a, b, op, MeshBooleanOptions{.grid = grid});
+}
+
 Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid,
                            const BooleanConfig& config, Context* ctx, std::array<BuildReport, 2>* reports) {
+  return mesh_boolean(a, b, op, MeshBooleanOptions{grid, config, ctx, reports});
+}
+
+Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op,
+                           const MeshBooleanOptions& options) {
+  const GridConfig& grid = options.grid;
+  const BooleanConfig& config = options.boolean;
+  Context* ctx = options.ctx;
+  std::array<BuildReport, 2>* reports = options.reports;
   Status s = check_boolean_config(config);
   if (s.ok()) s = check_mesh(a, "first mesh");
   if (s.ok()) s = check_mesh(b, "second mesh");

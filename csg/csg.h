@@ -80,14 +80,23 @@ Status check_boolean_config(const BooleanConfig& config);
 Result<World> boolean(const World& a, const World& b, BooleanOp op, const BooleanConfig& config = {},
                       Context* ctx = nullptr);
 
-// Builds two meshes into one lattice sized for both (`grid` as for
-// build_from_mesh, applied to their joint bounds) and combines them: what
+struct MeshBooleanOptions {
+  GridConfig grid;        // as for build_from_mesh, applied to the meshes' joint bounds
+  BooleanConfig boolean;  // how the two LDCs merge
+  Context* ctx = nullptr;                         // progress and cancel (may be null)
+  std::array<BuildReport, 2>* reports = nullptr;  // out, when set: the two builds' reports, a's first
+};
+
+// Builds two meshes into one lattice sized for both and combines them: what
 // `ldc boolean` does. Open, self-intersecting and non-manifold meshes are
-// accepted (their LDCs are repaired, see build_from_mesh). `reports`, when
-// given, receives the two builds' reports (repaired rays and all), a's first.
-Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid,
-                           const BooleanConfig& config = {}, Context* ctx = nullptr,
-                           std::array<BuildReport, 2>* reports = nullptr);
+// accepted (their LDCs are repaired, see build_from_mesh).
+Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op,
+                           const MeshBooleanOptions& options);
+// The same with only the grid chosen.
+Result<World> mesh_boolean(const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid);
+[[deprecated("pass a MeshBooleanOptions")]] Result<World> mesh_boolean(
+    const TriangleMesh& a, const TriangleMesh& b, BooleanOp op, const GridConfig& grid, const BooleanConfig& config,
+    Context* ctx = nullptr, std::array<BuildReport, 2>* reports = nullptr);
 
 // --- Brushes --------------------------------------------------------------------
 

@@ -116,7 +116,8 @@ int run_boolean(const BooleanArgs& a, const CommonOptions& common) {
   double load = t.seconds();
   ScopedTimer b(nullptr, "");
   std::array<BuildReport, 2> builds;
-  Result<World> w = mesh_boolean(first.value(), second.value(), op.value(), a.grid, a.config, bar.context(), &builds);
+  Result<World> w = mesh_boolean(first.value(), second.value(), op.value(),
+                                 {.grid = a.grid, .boolean = a.config, .ctx = bar.context(), .reports = &builds});
   if (!w.ok()) return fail("boolean", w.status());
   // No surface point and no solid chunk: the mesh written will have no triangles.
   const bool empty = !w.value().solid_bounds().has_value();
