@@ -94,7 +94,7 @@ struct ClosestPoint {
 };
 
 struct OrientedBox {
-  glm::dvec3 center{0.0};        // [Units: m]
+  glm::dvec3 centre{0.0};        // [Units: m] (0.2 spelled it center)
   glm::dvec3 half_extents{0.5};  // [Units: m] [Limit: > 0]
   glm::dmat3 rotation{1.0};      // columns: the box's axes in world space [Limit: orthonormal]
 };
@@ -142,7 +142,7 @@ class Queries {
   // sphere whose centre lies more than radius + 16 h below the surface reports
   // that much as its depth, with the normal +z: the surface is not searched
   // further. A box or capsule wholly inside the solid overlaps with depth 0.
-  Result<Overlap> overlap(const glm::dvec3& center, double radius) const;  // sphere
+  Result<Overlap> overlap(const glm::dvec3& centre, double radius) const;  // sphere
   Result<Overlap> overlap(const OrientedBox& box) const;
   Result<Overlap> overlap(const Capsule& capsule) const;
 

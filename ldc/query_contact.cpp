@@ -265,12 +265,12 @@ Result<ClosestPoint> Queries::closest_point(const glm::dvec3& p, double max_dist
   return out;
 }
 
-Result<Overlap> Queries::overlap(const glm::dvec3& center, double radius) const {
-  Status s = check_point("overlap: sphere centre", center);
+Result<Overlap> Queries::overlap(const glm::dvec3& centre, double radius) const {
+  Status s = check_point("overlap: sphere centre", centre);
   if (s.ok()) s = check_positive("overlap: sphere radius", radius);
   if (!s.ok()) return s;
   const double h = world_->lattice().cell_size;
-  const glm::dvec3 x = world_->lattice().to_lattice(center);
+  const glm::dvec3 x = world_->lattice().to_lattice(centre);
   const double r = radius / h;
   const bool inside = inside_solid(*this, x);
   // Inside, the sphere must move out by its radius past the nearest surface.
@@ -293,7 +293,7 @@ Result<Overlap> Queries::overlap(const glm::dvec3& center, double radius) const 
 }
 
 Result<Overlap> Queries::overlap(const OrientedBox& box) const {
-  Status s = check_point("overlap: box centre", box.center);
+  Status s = check_point("overlap: box centre", box.centre);
   for (int a = 0; a < 3 && s.ok(); ++a) s = check_positive("overlap: box half extent", box.half_extents[a]);
   if (!s.ok()) return s;
   const glm::dmat3 rtr = glm::transpose(box.rotation) * box.rotation;
@@ -303,7 +303,7 @@ Result<Overlap> Queries::overlap(const OrientedBox& box) const {
         return Status(ErrorCode::kInvalidArgument, "overlap: box rotation is not orthonormal");
   const double h = world_->lattice().cell_size;
   BoxShape shape;
-  shape.c = world_->lattice().to_lattice(box.center);
+  shape.c = world_->lattice().to_lattice(box.centre);
   shape.e = box.half_extents / h;
   shape.r = box.rotation;
   return shape_overlap(*this, shape, h);

@@ -422,14 +422,14 @@ TEST(Overlap, SphereBoxAndCapsuleAgainstABox) {
   EXPECT_FALSE(queries.overlap(glm::dvec3(0.1, 0.2, 1.6), 0.5).value().overlaps);
   // A box rotated about z, sunk 0.2 into the top face.
   OrientedBox box;
-  box.center = glm::dvec3(0.1, -0.2, 1.3);
+  box.centre = glm::dvec3(0.1, -0.2, 1.3);
   box.half_extents = glm::dvec3(0.3, 0.2, 0.5);
   box.rotation = glm::dmat3(glm::rotate(glm::dmat4(1.0), 0.6, glm::dvec3(0, 0, 1)));
   o = queries.overlap(box).value();
   EXPECT_TRUE(o.overlaps);
   EXPECT_NEAR(o.depth, 0.2, 0.1 * h);
   EXPECT_GT(o.normal.z, 0.99f);
-  box.center.z = 1.55;
+  box.centre.z = 1.55;
   EXPECT_FALSE(queries.overlap(box).value().overlaps);
   // A lying capsule 0.1 into the top face, and one above it.
   Capsule capsule{glm::dvec3(-0.4, 0.0, 1.15), glm::dvec3(0.5, 0.1, 1.15), 0.25};
@@ -440,7 +440,7 @@ TEST(Overlap, SphereBoxAndCapsuleAgainstABox) {
   capsule.a.z = capsule.b.z = 1.3;
   EXPECT_FALSE(queries.overlap(capsule).value().overlaps);
   // A small box wholly inside the solid overlaps.
-  box.center = glm::dvec3(0.0);
+  box.centre = glm::dvec3(0.0);
   box.half_extents = glm::dvec3(0.1);
   EXPECT_TRUE(queries.overlap(box).value().overlaps);
 }
