@@ -281,7 +281,7 @@ Result<Overlap> Queries::overlap(const glm::dvec3& centre, double radius) const 
   if (!n.found) {  // deep inside: at least this deep
     out.depth = (r + r + kDeepCells) * h;
     out.normal = glm::vec3(0.0f, 0.0f, 1.0f);
-    out.point = center;
+    out.point = centre;
     return out;
   }
   const double dist = std::sqrt(n.distance2);
