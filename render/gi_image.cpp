@@ -10,7 +10,10 @@
 namespace ldc {
 
 Result<RadianceImage> render_gi(const Queries& queries, const Camera& cam, GiEngine& gi,
-                                const MaterialTable& materials, const SkyLight& sky, int bounces) {
+                                const GiImageOptions& options) {
+  const MaterialTable& materials = options.materials;
+  const SkyLight& sky = options.sky;
+  const int bounces = options.bounces;
   if (bounces < 1 || bounces > 3) {
     return Status(ErrorCode::kInvalidArgument, "bounces " + std::to_string(bounces) + ": must be 1 .. 3");
   }

@@ -158,12 +158,19 @@ struct RadianceImage {
   std::vector<glm::vec3> pixels;  // width * height [Units: radiance]
 };
 
-// Primary hits by ray cast, one irradiance query per hit (`bounces`, 1 .. 3,
-// as GiEngine::irradiance): albedo / pi * irradiance + emission from
-// `materials`; misses show lights.sky, a start inside the solid black. The
-// engine must be loaded and lit (GiEngine::load, update_all).
+// How render_gi shades its hits.
+struct GiImageOptions {
+  MaterialTable materials = default_material_table();  // albedo and emission per material id
+  SkyLight sky;                                        // what misses show
+  int bounces = 1;  // as GiEngine::irradiance [Limit: 1 .. 3]
+};
+
+// Primary hits by ray cast, one irradiance query per hit: albedo / pi *
+// irradiance + emission from the materials; misses show the sky, a start
+// inside the solid black. The engine must be loaded and lit
+// (GiEngine::load, update_all).
 Result<RadianceImage> render_gi(const Queries& queries, const Camera& camera, GiEngine& gi,
-                                const MaterialTable& materials, const SkyLight& sky, int bounces);
+                                const GiImageOptions& options);
 
 // Per channel: times `exposure`, then x / (1 + x), then gamma 2.2, to 8 bits;
 // a product that is not > 0 (negative, NaN) gives 0.

@@ -199,7 +199,8 @@ Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, 
   r.lighting = upd.value();
   ScopedTimer t_img(nullptr, "");
   Queries queries(world);
-  Result<RadianceImage> lit = render_gi(queries, cam, *gi.value(), r.cascades.materials, lights.sky, a.bounces);
+  Result<RadianceImage> lit =
+      render_gi(queries, cam, *gi.value(), {.materials = r.cascades.materials, .sky = lights.sky, .bounces = a.bounces});
   if (!lit.ok()) return lit.status();
   r.image_seconds = t_img.seconds();
   Image image = tone_map(lit.value(), a.exposure);
