@@ -219,23 +219,59 @@ Result<ContourMesh> marching_cubes(const World& world, Context* ctx = nullptr);
 
 // --- Mesh quality -------------------------------------------------------------
 
+// What a mesh is, topologically and geometrically. Vertices are identified by
+// index (a mesh that repeats a position under two indices is not welded).
 struct MeshQuality {
   size_t triangles = 0;
   size_t vertices = 0;
   size_t boundary_edges = 0;        // edges used by one triangle
   size_t nonmanifold_edges = 0;     // edges used by more than two triangles
-  size_t unpaired_edges = 0;        // edges not used once in each direction
-  size_t nonmanifold_vertices = 0;  // vertices whose triangle fan is not one disc
-  size_t degenerate_triangles = 0;  // zero area
+  size_t unpaired_edges = 0;        // edges not used once in each direction (boundary edges included)
+  // Vertices whose triangles do not form one fan (a disc, or a half-disc at a
+  // boundary) through edges used by exactly two triangles: bow-ties, the ends
+  // of non-manifold edges. The vertices CGAL's orient_polygon_soup would
+  // duplicate on a consistently oriented mesh.
+  size_t nonmanifold_vertices = 0;
+  // Pairs of triangles that intersect beyond the vertices and edge they share
+  // (exact predicates; touching counts; see contour/detail/triangle_intersection.h):
+  // two triangles on one edge folded onto each other in one plane, a triangle
+  // through another, two triangles at one vertex that overlap. The count
+  // CGAL's Polygon_mesh_processing::self_intersections reports, without the
+  // degenerate triangles it lists as pairs of one triangle.
+  size_t self_intersecting_pairs = 0;
+  // Zero area: a repeated or bad index (left out of every count above), or
+  // corners on one line (sine of the angle below 1e-15; left out of the
+  // self-intersection test, as CGAL leaves them out: it reports each as a
+  // pair of one triangle).
+  size_t degenerate_triangles = 0;
   size_t unused_vertices = 0;
   // Minimum angle of each triangle, in bins of 10 degrees: [0,10), [10,20) .. [50,60].
   size_t min_angle_histogram[6] = {0, 0, 0, 0, 0, 0};
   double min_angle_deg = 0.0;
   double area = 0.0;
   double volume = 0.0;              // signed, from the triangles
-  bool closed() const { return boundary_edges == 0 && unpaired_edges == 0; }
+
+  // Every edge used once in each direction: no cracks, consistently oriented
+  // (non-manifold edges used twice each way and bow-tie vertices allowed).
+  bool watertight() const { return boundary_edges == 0 && unpaired_edges == 0; }
+  // A closed 2-manifold without self-intersections: watertight, no
+  // non-manifold edge or vertex, no intersecting triangle pair and no
+  // degenerate triangle (which CGAL's does_self_intersect counts too). What a
+  // slicer, a physics engine's decomposition or another boolean needs.
+  bool closed() const {
+    return watertight() && nonmanifold_edges == 0 && nonmanifold_vertices == 0 && self_intersecting_pairs == 0 &&
+           degenerate_triangles == 0;
+  }
 };
 
+// Measures the mesh. Linear in its size plus the self-intersection test (a
+// uniform grid over the triangles' boxes, parallel with TBB): about 0.8 s per
+// million triangles on 2 cores, 0.6 s of it the self-intersection test. The
+// same result for any thread count.
 MeshQuality mesh_quality(const ContourMesh& mesh);
+
+// What keeps the mesh from being closed(), e.g. "12 boundary edges, 3
+// non-manifold vertices, 40 self-intersecting triangle pairs"; "" when closed.
+std::string quality_failures(const MeshQuality& quality);
 
 }  // namespace ldc

@@ -5,6 +5,14 @@
 // from the crossing entering the run to the crossing leaving it (so a face
 // with two diagonal inside corners separates them, the same from both cubes
 // sharing the face). The segments close into loops, fanned into triangles.
+//
+// Welding: a vertex is a lattice edge's crossing, so it is named by the edge
+// (its lower node and axis). Chunks are meshed in parallel, each keeping the
+// edges its vertices lie on; the edge belongs to the chunk that holds its
+// lower node. When the parts are joined, a chunk's own vertices are numbered
+// chunk by chunk in a fixed order and a vertex on a neighbour's edge takes
+// the neighbour's number: every crossing is one vertex, the same for any
+// thread count.
 #include <array>
 #include <atomic>
 #include <mutex>
@@ -46,9 +54,23 @@ CubeEdge edge_between(int a, int b) {
   return e;
 }
 
+// A lattice edge relative to a chunk's first node (offsets 0 .. chunk size).
+uint32_t edge_key(const glm::ivec3& offset, int axis) {
+  return uint32_t(offset.x) | uint32_t(offset.y) << 7 | uint32_t(offset.z) << 14 | uint32_t(axis) << 21;
+}
+
+// One chunk's mesh, with the lattice edge of each vertex.
+struct Part {
+  ContourMesh mesh;
+  std::vector<glm::ivec3> vertex_node;  // the edge's lower node
+  std::vector<uint8_t> vertex_axis;
+  std::unordered_map<uint32_t, uint32_t> ids;  // edge_key (relative to the chunk) -> vertex
+};
+
 class CubeMesher {
  public:
-  CubeMesher(const World& w, const detail::Region& r, ContourMesh& out) : w_(w), r_(r), out_(out) {}
+  CubeMesher(const World& w, const detail::Region& r, const glm::ivec3& cell_lo, Part& out)
+      : w_(w), r_(r), cell_lo_(cell_lo), part_(out), out_(out.mesh), ids_(out.ids) {}
 
   void cube(const glm::ivec3& cell) {
     bool in[8];
@@ -68,8 +90,7 @@ class CubeMesher {
 
   uint32_t vertex(const glm::ivec3& cell, const CubeEdge& e) {
     glm::ivec3 node = cell + e.offset;
-    uint64_t key = (uint64_t(uint32_t(node.x + (1 << 20))) << 43) ^ (uint64_t(uint32_t(node.y + (1 << 20))) << 22) ^
-                   (uint64_t(uint32_t(node.z + (1 << 20))) << 1) ^ uint64_t(e.axis) << 62;
+    const uint32_t key = edge_key(node - cell_lo_, e.axis);
     auto it = ids_.find(key);
     if (it != ids_.end()) return it->second;
     const detail::EdgeCrossing* x = r_.crossing(e.axis, node);
@@ -79,6 +100,8 @@ class CubeMesher {
     out_.positions.push_back(w_.lattice().to_world(p));
     out_.normals.push_back(x->normal);
     out_.vertex_material.push_back(x->material);
+    part_.vertex_node.push_back(node);
+    part_.vertex_axis.push_back(uint8_t(e.axis));
     ids_.emplace(key, id);
     return id;
   }
@@ -118,9 +141,13 @@ class CubeMesher {
 
   const World& w_;
   const detail::Region& r_;
+  glm::ivec3 cell_lo_;
+  Part& part_;
   ContourMesh& out_;
-  std::unordered_map<uint64_t, uint32_t> ids_;
+  std::unordered_map<uint32_t, uint32_t>& ids_;
 };
+
+int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 
 }  // namespace
 
@@ -131,7 +158,7 @@ Result<ContourMesh> marching_cubes(const World& world, Context* ctx) {
   for (int z = lo.z; z < hi.z; ++z)
     for (int y = lo.y; y < hi.y; ++y)
       for (int x = lo.x; x < hi.x; ++x) chunks.emplace_back(x, y, z);
-  std::vector<ContourMesh> parts(chunks.size());
+  std::vector<Part> parts(chunks.size());
   tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t i) {
     if (ctx && ctx->cancelled()) return;
     glm::ivec3 cell_lo = chunks[i] * c, cell_hi = cell_lo + c;
@@ -141,21 +168,81 @@ Result<ContourMesh> marching_cubes(const World& world, Context* ctx) {
     detail::Region region;
     region.load(world, cell_lo, cell_hi + 1, cell_lo, cell_hi);
     if (region.uniform()) return;
-    CubeMesher mesher(world, region, parts[i]);
+    CubeMesher mesher(world, region, cell_lo, parts[i]);
     for (int z = cell_lo.z; z < cell_hi.z; ++z)
       for (int y = cell_lo.y; y < cell_hi.y; ++y)
         for (int x = cell_lo.x; x < cell_hi.x; ++x) mesher.cube({x, y, z});
   });
   if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "marching cubes: cancelled");
-  ContourMesh out;  // chunk parts concatenated; vertices on chunk borders appear in both parts
-  for (const ContourMesh& p : parts) {
-    uint32_t base = uint32_t(out.positions.size());
-    out.positions.insert(out.positions.end(), p.positions.begin(), p.positions.end());
-    out.normals.insert(out.normals.end(), p.normals.begin(), p.normals.end());
-    out.vertex_material.insert(out.vertex_material.end(), p.vertex_material.begin(), p.vertex_material.end());
-    for (const glm::uvec3& t : p.triangles) out.triangles.push_back(t + glm::uvec3(base));
-    out.triangle_material.insert(out.triangle_material.end(), p.triangle_material.begin(), p.triangle_material.end());
-  }
+
+  // Weld: each vertex resolves to the part owning its edge (the chunk of its
+  // lower node), where the edge's cube made it too; own vertices are numbered
+  // part by part.
+  const glm::ivec3 dims = hi - lo;
+  constexpr uint32_t kOwn = UINT32_MAX;
+  std::vector<std::vector<uint32_t>> owner_vertex(parts.size());  // kOwn, or the vertex in the owner part
+  std::vector<std::vector<uint32_t>> owner_part(parts.size());
+  std::vector<size_t> own_count(parts.size() + 1, 0);
+  tbb::parallel_for(size_t{0}, parts.size(), [&](size_t i) {
+    const Part& p = parts[i];
+    owner_vertex[i].assign(p.mesh.vertex_count(), kOwn);
+    owner_part[i].assign(p.mesh.vertex_count(), uint32_t(i));
+    size_t own = 0;
+    for (size_t v = 0; v < p.mesh.vertex_count(); ++v) {
+      const glm::ivec3 node = p.vertex_node[v];
+      const glm::ivec3 owner(floor_div(node.x, c), floor_div(node.y, c), floor_div(node.z, c));
+      if (owner != chunks[i] && glm::all(glm::greaterThanEqual(owner, lo)) && glm::all(glm::lessThan(owner, hi))) {
+        const glm::ivec3 r = owner - lo;
+        const size_t j = (size_t(r.z) * size_t(dims.y) + size_t(r.y)) * size_t(dims.x) + size_t(r.x);
+        auto it = parts[j].ids.find(edge_key(node - owner * c, p.vertex_axis[v]));
+        if (it != parts[j].ids.end()) {
+          owner_vertex[i][v] = it->second;
+          owner_part[i][v] = uint32_t(j);
+          continue;
+        }
+      }
+      ++own;  // on its own edge (or, never expected, an edge its owner did not mesh)
+    }
+    own_count[i + 1] = own;
+  });
+  for (size_t i = 0; i < parts.size(); ++i) own_count[i + 1] += own_count[i];
+  // Global ids of every part's own vertices.
+  std::vector<std::vector<uint32_t>> global(parts.size());
+  tbb::parallel_for(size_t{0}, parts.size(), [&](size_t i) {
+    global[i].assign(parts[i].mesh.vertex_count(), kOwn);
+    uint32_t next = uint32_t(own_count[i]);
+    for (size_t v = 0; v < global[i].size(); ++v)
+      if (owner_vertex[i][v] == kOwn) global[i][v] = next++;
+  });
+  ContourMesh out;
+  const size_t vertex_total = own_count.back();
+  out.positions.resize(vertex_total);
+  out.normals.resize(vertex_total);
+  out.vertex_material.resize(vertex_total);
+  std::vector<size_t> triangle_base(parts.size() + 1, 0);
+  for (size_t i = 0; i < parts.size(); ++i) triangle_base[i + 1] = triangle_base[i] + parts[i].mesh.triangle_count();
+  out.triangles.resize(triangle_base.back());
+  out.triangle_material.resize(triangle_base.back());
+  tbb::parallel_for(size_t{0}, parts.size(), [&](size_t i) {
+    const ContourMesh& m = parts[i].mesh;
+    for (size_t v = 0; v < m.vertex_count(); ++v) {
+      if (owner_vertex[i][v] != kOwn) {
+        global[i][v] = global[owner_part[i][v]][owner_vertex[i][v]];
+        continue;
+      }
+      out.positions[global[i][v]] = m.positions[v];
+      out.normals[global[i][v]] = m.normals[v];
+      out.vertex_material[global[i][v]] = m.vertex_material[v];
+    }
+  });
+  tbb::parallel_for(size_t{0}, parts.size(), [&](size_t i) {
+    const ContourMesh& m = parts[i].mesh;
+    for (size_t t = 0; t < m.triangle_count(); ++t) {
+      const glm::uvec3& tri = m.triangles[t];
+      out.triangles[triangle_base[i] + t] = {global[i][tri.x], global[i][tri.y], global[i][tri.z]};
+      out.triangle_material[triangle_base[i] + t] = m.triangle_material[t];
+    }
+  });
   return out;
 }
 

@@ -1,20 +1,43 @@
-// mesh_quality: topology (edges, fans) and shape (angles, area, volume).
+// mesh_quality: topology (edges, fans), self-intersections and shape
+// (angles, area, volume).
 //
 // Topology is read vertex by vertex from a vertex -> triangles table (built
 // with a counting sort, so linear): the edges at a vertex are named by their
 // other end, and a short sort of the 2k edge ends of a vertex's k triangles
 // groups the triangles sharing each edge. Each undirected edge is counted
 // once, at its smaller end. A union-find over the vertex's triangles joined
-// through shared edges counts its fans.
+// through shared edges counts its fans. A vertex is non-manifold when its
+// triangles form more than one fan or it has an edge used by more than two
+// triangles (then the triangles around that edge are fans of their own): the
+// same vertices CGAL's orient_polygon_soup finds singular, on a consistently
+// oriented mesh.
+//
+// Self-intersections: every triangle's bounding box goes into the cells of a
+// uniform grid it overlaps (cells about twice the mean box size); the (cell,
+// triangle) entries are sorted by cell, and the cells are scanned in
+// parallel. A pair whose boxes overlap is tested only in the cell that holds
+// the low corner of the overlap, so once, and with exact predicates
+// (contour/detail/triangle_intersection.h), so the count is the same for any
+// thread count.
 //
 // Triangles with an index out of range or a repeated index have no edges
 // and no area: they are counted as degenerate and left out of the topology
-// (their edges would cancel each other and make clean neighbours look broken).
+// (their edges would cancel each other and make clean neighbours look broken)
+// and of the self-intersection test, as are triangles whose corners are
+// exactly collinear.
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
+#include <string>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/parallel_sort.h>
 
 #include "contour/contour.h"
+#include "contour/detail/triangle_intersection.h"
 
 namespace ldc {
 namespace {
@@ -170,6 +193,143 @@ void add_shape(const ContourMesh& mesh, MeshQuality& quality) {
   quality.min_angle_deg = mesh.triangles.empty() ? 0.0 : min_angle;
 }
 
+// --- Self-intersections -------------------------------------------------------
+
+struct Box {
+  glm::dvec3 lo, hi;
+};
+
+bool boxes_overlap(const Box& a, const Box& b) {
+  return a.lo.x <= b.hi.x && b.lo.x <= a.hi.x && a.lo.y <= b.hi.y && b.lo.y <= a.hi.y && a.lo.z <= b.hi.z &&
+         b.lo.z <= a.hi.z;
+}
+
+// A uniform grid over the mesh's box; cell() is monotone in each coordinate,
+// so a point inside a triangle's box falls in one of the box's cells.
+struct Grid {
+  glm::dvec3 origin{0.0};
+  double size = 1.0;
+  glm::ivec3 dims{1};
+
+  glm::ivec3 cell(const glm::dvec3& p) const {
+    glm::ivec3 c;
+    for (int k = 0; k < 3; ++k) {
+      const double x = std::floor((p[k] - origin[k]) / size);
+      c[k] = x <= 0.0 ? 0 : x >= dims[k] - 1 ? dims[k] - 1 : static_cast<int>(x);
+    }
+    return c;
+  }
+  uint64_t key(const glm::ivec3& c) const {
+    return (uint64_t(c.z) * uint64_t(dims.y) + uint64_t(c.y)) * uint64_t(dims.x) + uint64_t(c.x);
+  }
+  uint64_t cells_of(const Box& b) const {
+    const glm::ivec3 lo = cell(b.lo), hi = cell(b.hi);
+    return uint64_t(hi.x - lo.x + 1) * uint64_t(hi.y - lo.y + 1) * uint64_t(hi.z - lo.z + 1);
+  }
+};
+
+struct Entry {
+  uint64_t cell;
+  uint32_t triangle;
+  bool single_cell;  // the triangle's box lies in this one cell
+  bool operator<(const Entry& e) const { return cell != e.cell ? cell < e.cell : triangle < e.triangle; }
+};
+
+size_t count_self_intersections(const ContourMesh& mesh) {
+  const size_t n = mesh.triangle_count();
+  // Triangles to test (not degenerate) and their boxes.
+  std::vector<uint8_t> testable(n, 0);
+  std::unique_ptr<Box[]> boxes(new Box[n]);  // not zeroed: written where testable
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t != r.end(); ++t) {
+      const glm::uvec3& tri = mesh.triangles[t];
+      if (!has_edges(mesh, tri)) continue;
+      const glm::dvec3 &a = mesh.positions[tri.x], &b = mesh.positions[tri.y], &c = mesh.positions[tri.z];
+      if (detail::collinear(a, b, c)) continue;
+      testable[t] = 1;
+      boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+    }
+  });
+  std::vector<uint32_t> ids;
+  Box all{glm::dvec3(INFINITY), glm::dvec3(-INFINITY)};
+  double extent_sum = 0.0;
+  for (size_t t = 0; t < n; ++t) {
+    if (!testable[t]) continue;
+    ids.push_back(static_cast<uint32_t>(t));
+    all.lo = glm::min(all.lo, boxes[t].lo);
+    all.hi = glm::max(all.hi, boxes[t].hi);
+    const glm::dvec3 e = boxes[t].hi - boxes[t].lo;
+    extent_sum += std::max(e.x, std::max(e.y, e.z));
+  }
+  if (ids.size() < 2) return 0;
+  if (!std::isfinite(extent_sum) || !std::isfinite(all.hi.x - all.lo.x) || !std::isfinite(all.hi.y - all.lo.y) ||
+      !std::isfinite(all.hi.z - all.lo.z))
+    return 0;  // positions that are not finite: nothing meaningful to count
+
+  // Cells about twice the mean box, at most 2^20 along an axis; grown while
+  // big triangles would put more than 16 entries per triangle in the grid.
+  Grid grid;
+  grid.origin = all.lo;
+  const double span = std::max(all.hi.x - all.lo.x, std::max(all.hi.y - all.lo.y, all.hi.z - all.lo.z));
+  grid.size = std::max({2.0 * extent_sum / double(ids.size()), span / double(1 << 20), 1e-300});
+  std::vector<uint64_t> offset(ids.size() + 1, 0);
+  for (;;) {
+    for (int k = 0; k < 3; ++k) grid.dims[k] = static_cast<int>(std::floor((all.hi[k] - all.lo[k]) / grid.size)) + 1;
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, ids.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+      for (size_t i = r.begin(); i != r.end(); ++i) offset[i + 1] = grid.cells_of(boxes[ids[i]]);
+    });
+    for (size_t i = 0; i < ids.size(); ++i) offset[i + 1] += offset[i];
+    if (offset.back() <= 16 * uint64_t(ids.size()) + 1024) break;
+    grid.size *= 2.0;
+  }
+  const size_t entry_count = offset.back();
+  std::unique_ptr<Entry[]> entries(new Entry[entry_count]);  // not zeroed: every one is written
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, ids.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const glm::ivec3 lo = grid.cell(boxes[ids[i]].lo), hi = grid.cell(boxes[ids[i]].hi);
+      const bool single = lo == hi;
+      uint64_t at = offset[i];
+      for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+          for (int x = lo.x; x <= hi.x; ++x) entries[at++] = {grid.key({x, y, z}), ids[i], single};
+    }
+  });
+  tbb::parallel_sort(entries.get(), entries.get() + entry_count);
+  std::vector<size_t> runs;  // entries[runs[k] .. runs[k + 1]) share a cell
+  for (size_t i = 0; i < entry_count; ++i)
+    if (i == 0 || entries[i].cell != entries[i - 1].cell) runs.push_back(i);
+  runs.push_back(entry_count);
+
+  return tbb::parallel_reduce(
+      tbb::blocked_range<size_t>(0, runs.size() - 1, 64), size_t{0},
+      [&](const tbb::blocked_range<size_t>& r, size_t count) {
+        std::vector<Box> cell_boxes;  // the run's boxes side by side
+        for (size_t k = r.begin(); k != r.end(); ++k) {
+          const Entry* run = entries.get() + runs[k];
+          const size_t size = runs[k + 1] - runs[k];
+          cell_boxes.resize(size);
+          for (size_t i = 0; i < size; ++i) cell_boxes[i] = boxes[run[i].triangle];
+          for (size_t i = 0; i < size; ++i) {
+            const Box& bt = cell_boxes[i];
+            for (size_t j = i + 1; j < size; ++j) {
+              const Box& bu = cell_boxes[j];
+              if (!boxes_overlap(bt, bu)) continue;
+              // Tested once: in the cell of the overlap's low corner (which
+              // lies in both boxes, so in this cell if either box has no other).
+              if (!run[i].single_cell && !run[j].single_cell &&
+                  grid.key(grid.cell(glm::max(bt.lo, bu.lo))) != run[0].cell)
+                continue;
+              if (detail::triangle_pair_intersects(mesh.positions.data(), mesh.triangles[run[i].triangle],
+                                                   mesh.triangles[run[j].triangle]))
+                ++count;
+            }
+          }
+        }
+        return count;
+      },
+      [](size_t a, size_t b) { return a + b; });
+}
+
 }  // namespace
 
 MeshQuality mesh_quality(const ContourMesh& mesh) {
@@ -178,7 +338,25 @@ MeshQuality mesh_quality(const ContourMesh& mesh) {
   quality.vertices = mesh.vertex_count();
   add_topology(mesh, quality);
   add_shape(mesh, quality);
+  quality.self_intersecting_pairs = count_self_intersections(mesh);
   return quality;
+}
+
+std::string quality_failures(const MeshQuality& q) {
+  std::string out;
+  auto add = [&](size_t count, const char* one, const char* many) {
+    if (count == 0) return;
+    if (!out.empty()) out += ", ";
+    out += std::to_string(count) + " " + (count == 1 ? one : many);
+  };
+  add(q.boundary_edges, "boundary edge", "boundary edges");
+  add(q.unpaired_edges - std::min(q.unpaired_edges, q.boundary_edges), "edge not used once in each direction",
+      "edges not used once in each direction");
+  add(q.nonmanifold_edges, "non-manifold edge", "non-manifold edges");
+  add(q.nonmanifold_vertices, "non-manifold vertex", "non-manifold vertices");
+  add(q.self_intersecting_pairs, "self-intersecting triangle pair", "self-intersecting triangle pairs");
+  add(q.degenerate_triangles, "degenerate triangle", "degenerate triangles");
+  return out;
 }
 
 }  // namespace ldc

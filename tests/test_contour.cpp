@@ -10,9 +10,11 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <meshoptimizer.h>
+#include <tbb/task_arena.h>
 
 #include "contour/contour.h"
 #include "ldc/build.h"
+#include "ldc/terrain.h"
 #include "test_util.h"
 
 namespace ldc {
@@ -53,7 +55,7 @@ void expect_box_kept(const BoxCase& b, const ContourConfig& config, const char* 
     EXPECT_LT(nearest, 0.05 * h) << name << " corner " << c;
   }
   MeshQuality quality = mesh_quality(m);
-  EXPECT_TRUE(quality.closed()) << name;
+  EXPECT_TRUE(quality.watertight()) << name;
   const double volume = 8.0 * b.half.x * b.half.y * b.half.z * std::abs(glm::determinant(glm::dmat3(b.transform)));
   EXPECT_NEAR(quality.volume, volume, 0.01 * volume) << name;
 }
@@ -114,7 +116,7 @@ TEST(DualContouring, WithoutSlackVerticesStayInTheirCellsAndNearTheSurface) {
   }
   EXPECT_GT(stats.clamped_vertices, 0u);
   EXPECT_LT(worst, 0.4 * h);  // measured 0.31 h: the cost of staying in the cell
-  EXPECT_TRUE(mesh_quality(mesh).closed());
+  EXPECT_TRUE(mesh_quality(mesh).watertight());
 }
 
 TEST(DualContouring, SphereWithinOneHundredthOfACellOnAverage) {
@@ -180,7 +182,7 @@ TEST(DualContouring, SlabThinnerThanACellIsKeptOnlyAroundANodeLayer) {
   ContourMesh kept = contour_world(build_from_mesh(around_node, g).value(), {}, nullptr, &s1).value();
   ContourMesh lost = contour_world(build_from_mesh(between, g).value(), {}, nullptr, &s2).value();
   EXPECT_GT(kept.triangle_count(), 0u);
-  EXPECT_TRUE(mesh_quality(kept).closed());
+  EXPECT_TRUE(mesh_quality(kept).watertight());
   EXPECT_EQ(lost.triangle_count(), 0u);
   EXPECT_GT(s2.thin_edges, 0u);
 }
@@ -361,7 +363,7 @@ TEST(ChunkedMesh, ChunkMeshesRenderAloneWithoutCracks) {
       EXPECT_EQ(it->second, c.mesh.positions[v]);
     }
   EXPECT_GT(copies, 0u);
-  EXPECT_TRUE(mesh_quality(cm.assemble()).closed());
+  EXPECT_TRUE(mesh_quality(cm.assemble()).watertight());
 }
 
 TEST(ChunkedMesh, TrianglesAreOrderedForTheVertexCache) {
@@ -391,6 +393,39 @@ TEST(MarchingCubes, VerticesAreTheExactCrossings) {
   double area = mesh_quality(m).area;
   EXPECT_NEAR(area, 4.0 * M_PI, 0.02 * 4.0 * M_PI);
   EXPECT_GT(mesh_quality(m).volume, 0.0);  // oriented outward
+}
+
+// Every crossing is one vertex, whichever chunk's cube made it: no cracks at
+// chunk seams, and the same mesh for any thread count.
+void expect_welded_and_deterministic(const World& w, const char* name) {
+  ContourMesh m = marching_cubes(w).value();
+  ASSERT_GT(m.triangle_count(), 1000u) << name;
+  const MeshQuality q = mesh_quality(m);
+  EXPECT_EQ(q.boundary_edges, 0u) << name;
+  EXPECT_TRUE(q.watertight()) << name << ": " << quality_failures(q);
+  EXPECT_EQ(q.unused_vertices, 0u) << name;
+  ContourMesh one;
+  tbb::task_arena(1).execute([&] { one = marching_cubes(w).value(); });
+  EXPECT_EQ(one.positions, m.positions) << name;
+  EXPECT_EQ(one.triangles, m.triangles) << name;
+  EXPECT_EQ(one.normals, m.normals) << name;
+  EXPECT_EQ(one.triangle_material, m.triangle_material) << name;
+}
+
+TEST(MarchingCubes, SphereIsWeldedAcrossChunkSeams) {
+  Primitive p;
+  p.radius = 1.0;
+  World w = build_from_primitive(p, {.cells = 48, .chunk_size = 8}).value();
+  ASSERT_GT(w.chunk_dims().x, 4);
+  expect_welded_and_deterministic(w, "sphere");
+}
+
+TEST(MarchingCubes, LandscapeIsWeldedAcrossChunkSeams) {
+  TerrainConfig t;  // the default landscape, a 16 m x 16 m piece of it
+  t.size_x = 16.0;
+  t.size_y = 16.0;
+  World w = build_terrain(t, 0.25, 16).value();
+  expect_welded_and_deterministic(w, "landscape");
 }
 
 }  // namespace

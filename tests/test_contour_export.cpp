@@ -515,7 +515,8 @@ TEST(ContourQuality, TwoCubesSharingOnlyAVertexMakeItNonManifold) {
   const MeshQuality q = mesh_quality(mesh);
   EXPECT_EQ(q.nonmanifold_vertices, 1u);
   EXPECT_EQ(q.nonmanifold_edges, 0u);
-  EXPECT_TRUE(q.closed());
+  EXPECT_TRUE(q.watertight());
+  EXPECT_FALSE(q.closed());  // not a 2-manifold at the shared corner
 }
 
 TEST(ContourQuality, DegenerateTrianglesAndUnusedVerticesAreCounted) {

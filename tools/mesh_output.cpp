@@ -30,10 +30,13 @@ ExportOptions export_options(const World& w) {
 nlohmann::json quality_json(const MeshQuality& q, const ContourStats& s) {
   return {{"triangles", q.triangles},
           {"vertices", q.vertices},
-          {"closed", q.closed()},
+          {"closed", q.closed()},  // a closed 2-manifold without self-intersections
+          {"watertight", q.watertight()},
+          {"failures", quality_failures(q)},
           {"boundary_edges", q.boundary_edges},
           {"nonmanifold_edges", q.nonmanifold_edges},
           {"nonmanifold_vertices", q.nonmanifold_vertices},
+          {"self_intersecting_pairs", q.self_intersecting_pairs},
           {"unpaired_edges", q.unpaired_edges},
           {"degenerate_triangles", q.degenerate_triangles},
           {"min_angle_deg", q.min_angle_deg},
@@ -50,12 +53,16 @@ nlohmann::json quality_json(const MeshQuality& q, const ContourStats& s) {
 
 void print_report(const nlohmann::json& j) {
   const auto& q = j["quality"];
+  // "closed" only for a closed 2-manifold without self-intersections; otherwise what fails.
+  const std::string verdict =
+      q["closed"].get<bool>() ? "closed" : "NOT closed: " + q["failures"].get<std::string>();
   std::printf("%s: %zu triangles, %zu vertices, %s\n", j["output"].get<std::string>().c_str(),
-              q["triangles"].get<size_t>(), q["vertices"].get<size_t>(),
-              q["closed"].get<bool>() ? "closed" : "NOT closed");
-  std::printf("  boundary edges %zu, non-manifold edges %zu / vertices %zu, degenerate triangles %zu\n",
-              q["boundary_edges"].get<size_t>(), q["nonmanifold_edges"].get<size_t>(),
-              q["nonmanifold_vertices"].get<size_t>(), q["degenerate_triangles"].get<size_t>());
+              q["triangles"].get<size_t>(), q["vertices"].get<size_t>(), verdict.c_str());
+  std::printf("  %s; boundary edges %zu, non-manifold edges %zu / vertices %zu, self-intersecting pairs %zu, "
+              "degenerate triangles %zu\n",
+              q["watertight"].get<bool>() ? "watertight" : "NOT watertight", q["boundary_edges"].get<size_t>(),
+              q["nonmanifold_edges"].get<size_t>(), q["nonmanifold_vertices"].get<size_t>(),
+              q["self_intersecting_pairs"].get<size_t>(), q["degenerate_triangles"].get<size_t>());
   std::printf("  min angle %.1f deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
   for (const auto& b : q["min_angle_histogram_10deg"]) std::printf(" %zu", b.get<size_t>());
   std::printf("\n  area %.6g, volume %.6g\n", q["area"].get<double>(), q["volume"].get<double>());
@@ -104,7 +111,9 @@ int write_and_report(const std::string& command, const World& w, const ContourMe
   if (!s.ok()) return fail(command, s);
   report["ok"] = true;
   report["output"] = output;
+  ScopedTimer q(nullptr, "");
   report["quality"] = quality_json(mesh_quality(mesh), stats);
+  report["seconds"]["quality"] = q.seconds();  // the report's own cost (self-intersection test included)
   if (common.json) {
     std::printf("%s\n", report.dump(2).c_str());
     return 0;

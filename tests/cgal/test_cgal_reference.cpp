@@ -147,3 +147,103 @@ TEST(CgalReference, SelfIntersectionsOfContouredMeshesAreCounted) {
 
 }  // namespace
 }  // namespace ldc
+
+// --- The quality report's counts against CGAL's ---------------------------------
+
+#include "cgal/cgal_quality.h"
+#include "contour/detail/triangle_intersection.h"
+#include "csg/csg.h"
+#include "quality_meshes.h"
+
+namespace ldc {
+namespace {
+
+// mesh_quality's self-intersecting pairs and non-manifold edges and vertices
+// equal CGAL's (see cgal/cgal_quality.h for how CGAL counts them).
+void expect_quality_equals_cgal(const ContourMesh& m, const std::string& name) {
+  const MeshQuality q = mesh_quality(m);
+  const cgal_quality::Counts c = cgal_quality::counts(m);
+  EXPECT_EQ(q.self_intersecting_pairs, c.pairs) << name;
+  if (c.whole_mesh_pairs) {
+    EXPECT_EQ(q.self_intersecting_pairs, *c.whole_mesh_pairs) << name << " (whole mesh)";
+  }
+  EXPECT_EQ(q.nonmanifold_edges, c.nonmanifold_edges) << name;
+  EXPECT_EQ(q.nonmanifold_vertices, c.nonmanifold_vertices) << name;
+  EXPECT_EQ(c.degenerate, q.degenerate_triangles) << name;  // CGAL's pairs (f, f): collinear triangles
+  std::printf("%s: %zu triangles, %zu boundary edges, non-manifold edges %zu (CGAL %zu), vertices %zu (CGAL %zu), "
+              "self-intersecting pairs %zu (CGAL %zu%s)\n",
+              name.c_str(), q.triangles, q.boundary_edges, q.nonmanifold_edges, c.nonmanifold_edges,
+              q.nonmanifold_vertices, c.nonmanifold_vertices, q.self_intersecting_pairs, c.pairs,
+              c.whole_mesh_pairs ? ", whole mesh too" : "");
+}
+
+TEST(CgalReference, QualityCountsEqualCgalsOnHandMadeMeshes) {
+  for (const test::QualityCase& c : test::quality_cases()) {
+    expect_quality_equals_cgal(c.mesh, c.name);
+    EXPECT_EQ(cgal_quality::counts(c.mesh).pairs, c.self_intersecting_pairs) << c.name << ": the hand count";
+  }
+  // Unwelded cubes touching along a face, an edge and a corner: coplanar and touching pairs.
+  expect_quality_equals_cgal(test::box_pair({1, 0, 0}, {2, 1, 1}), "cubes sharing a face, unwelded");
+  expect_quality_equals_cgal(test::box_pair({1, 1, 0}, {2, 2, 1}), "cubes sharing an edge, unwelded");
+  expect_quality_equals_cgal(test::box_pair({1, 1, 1}, {2, 2, 2}), "cubes sharing a corner, unwelded");
+  expect_quality_equals_cgal(test::box_pair({0.25, 0.25, 0.25}, {0.75, 0.75, 1.0}), "cube inside touching the top");
+}
+
+// Random pairs of triangles on a 3 x 3 x 3 grid of points, sharing vertices
+// by chance: coplanar, touching, folded and crossing pairs in bulk.
+TEST(CgalReference, TrianglePairTestAgreesWithCgalOnGridTriangles) {
+  std::vector<glm::dvec3> grid;
+  for (int z = 0; z < 3; ++z)
+    for (int y = 0; y < 3; ++y)
+      for (int x = 0; x < 3; ++x) grid.push_back(glm::dvec3(x, y, z) * 0.1 + glm::dvec3(0.3, -0.7, 1.9));
+  const std::vector<cgal_quality::Point> p = cgal_quality::points(test::triangles(grid, {}));
+  std::mt19937 rng(11);
+  size_t tested = 0, intersecting = 0, shared_edge = 0, shared_vertex = 0;
+  while (tested < 20000) {
+    glm::uvec3 t(rng() % 27, rng() % 27, rng() % 27), u(rng() % 27, rng() % 27, rng() % 27);
+    if (detail::collinear(grid[t[0]], grid[t[1]], grid[t[2]]) || detail::collinear(grid[u[0]], grid[u[1]], grid[u[2]]))
+      continue;  // repeated indices are collinear too
+    int shared = 0;
+    for (int k = 0; k < 3; ++k)
+      for (int l = 0; l < 3; ++l) shared += t[k] == u[l];
+    const bool ours = detail::triangle_pair_intersects(grid.data(), t, u);
+    ASSERT_EQ(ours, cgal_quality::pair_intersects(p, t, u))
+        << "t = " << t.x << " " << t.y << " " << t.z << ", u = " << u.x << " " << u.y << " " << u.z;
+    ++tested;
+    intersecting += ours;
+    shared_edge += shared == 2;
+    shared_vertex += shared == 1;
+  }
+  std::printf("%zu pairs (%zu sharing an edge, %zu a vertex): %zu intersect\n", tested, shared_edge, shared_vertex,
+              intersecting);
+  EXPECT_GT(intersecting, tested / 10);
+  EXPECT_GT(shared_edge, 100u);
+  EXPECT_GT(shared_vertex, 1000u);
+}
+
+// What `ldc remesh --cells 64` writes for each shared mesh (iterative, the
+// default, and qef, which folds more).
+TEST(CgalReference, QualityCountsEqualCgalsOnRemeshedSharedMeshes) {
+  for (const char* name : {"spot.obj", "fandisk.obj", "stanford-bunny.obj", "rocker-arm.obj"}) {
+    World w = build_from_mesh(test::load_test_mesh(name), {.cells = 64}).value();
+    for (Placement method : {Placement::kIterative, Placement::kQef}) {
+      ContourMesh m = contour_world(w, {.placement = method}).value();
+      expect_quality_equals_cgal(m, std::string(name) + " " + placement_name(method) + " at 64 cells");
+    }
+  }
+}
+
+// What `ldc boolean` writes: two meshes on one lattice, combined, contoured.
+TEST(CgalReference, QualityCountsEqualCgalsOnBooleanResults) {
+  const TriangleMesh spot = test::load_test_mesh("spot.obj");
+  const TriangleMesh teapot = test::load_test_mesh("teapot.obj");
+  World united = mesh_boolean(spot, teapot, BooleanOp::kUnion, {.cells = 64}).value();
+  expect_quality_equals_cgal(contour_world(united).value(), "spot union teapot at 64 cells");
+  TriangleMesh moved = spot;
+  for (glm::dvec3& v : moved.positions) v += glm::dvec3(0.25, 0.1, 0.05);
+  World cut = mesh_boolean(spot, moved, BooleanOp::kSubtract, {.cells = 64}).value();
+  expect_quality_equals_cgal(contour_world(cut).value(), "spot subtract moved spot at 64 cells");
+}
+
+}  // namespace
+}  // namespace ldc
