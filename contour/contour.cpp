@@ -140,6 +140,16 @@ void sort_unique_chunks(std::vector<glm::ivec3>& chunks) {
   chunks.erase(std::unique(chunks.begin(), chunks.end()), chunks.end());
 }
 
+// The mesh of `chunk` among chunks[0, end), which are sorted by chunk; null if absent.
+template <class Chunks>
+auto find_sorted(Chunks& chunks, const glm::ivec3& chunk, size_t end) -> decltype(chunks.data()) {
+  const auto last = chunks.begin() + long(end);
+  const auto it = std::lower_bound(chunks.begin(), last, chunk, [](const ChunkMesh& m, const glm::ivec3& k) {
+    return chunk_order_less(m.chunk, k);
+  });
+  return it != last && it->chunk == chunk ? &*it : nullptr;
+}
+
 bool same_chunk_mesh(const ChunkMesh& a, const ChunkMesh& b) {
   return a.own_vertices == b.own_vertices && a.vertex_cell == b.vertex_cell && a.mesh.positions == b.mesh.positions &&
          a.mesh.normals == b.mesh.normals && a.mesh.vertex_material == b.mesh.vertex_material &&
@@ -199,9 +209,7 @@ Status ChunkedMesh::build(const World& world, Context* ctx) {
 }
 
 const ChunkMesh* ChunkedMesh::find(const glm::ivec3& chunk) const {
-  auto it = std::lower_bound(chunks_.begin(), chunks_.end(), chunk,
-                             [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_order_less(m.chunk, k); });
-  return it != chunks_.end() && it->chunk == chunk ? &*it : nullptr;
+  return find_sorted(chunks_, chunk, chunks_.size());
 }
 
 Result<MeshUpdate> ChunkedMesh::update(const World& world, std::span<const glm::ivec3> changed, Context* ctx) {
@@ -229,11 +237,9 @@ Result<MeshUpdate> ChunkedMesh::update(const World& world, std::span<const Dirty
   sort_unique_chunks(changed);
   if (!changed.empty()) ++version_;
   for (const glm::ivec3& ch : changed) {
-    auto it = std::lower_bound(chunks_.begin(), chunks_.end(), ch,
-                               [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_order_less(m.chunk, k); });
-    const bool exists = it != chunks_.end() && it->chunk == ch;
-    if (exists) it->version = version_;
-    result.changes.push_back({ch, exists ? version_ : 0});
+    ChunkMesh* m = find_sorted(chunks_, ch, chunks_.size());
+    if (m) m->version = version_;
+    result.changes.push_back({ch, m ? version_ : 0});
   }
   stats.seconds = timer.seconds();
   stats_.add_counts(stats);
@@ -248,12 +254,7 @@ size_t ChunkedMesh::splice(const detail::MeshPatch& patch, std::vector<glm::ivec
   chunks_of_box(patch.lo, patch.hi, c, targets);
   auto less = [](const ChunkMesh& a, const ChunkMesh& b) { return chunk_order_less(a.chunk, b.chunk); };
   const size_t kept = chunks_.size();  // the sorted part; chunks new to the mesh are appended below
-  auto find_kept = [&](const glm::ivec3& ch) -> ChunkMesh* {
-    auto end = chunks_.begin() + long(kept);
-    auto it = std::lower_bound(chunks_.begin(), end, ch,
-                               [](const ChunkMesh& m, const glm::ivec3& k) { return chunk_order_less(m.chunk, k); });
-    return it != end && it->chunk == ch ? &*it : nullptr;
-  };
+  auto find_kept = [&](const glm::ivec3& ch) { return find_sorted(chunks_, ch, kept); };
   std::vector<ChunkMesh> spliced(targets.size());
   std::vector<char> differs(targets.size(), 0);
   tbb::parallel_for(size_t{0}, targets.size(), [&](size_t i) {
@@ -286,12 +287,10 @@ ContourMesh ChunkedMesh::assemble() const {
   auto global_index = [&](const glm::ivec3& cell) -> uint32_t {
     glm::ivec3 owner(detail::floor_div(cell.x, chunk_size_), detail::floor_div(cell.y, chunk_size_),
                      detail::floor_div(cell.z, chunk_size_));
-    auto it = std::lower_bound(chunks_.begin(), chunks_.end(), owner,
-                               [](const ChunkMesh& m, const glm::ivec3& c) { return chunk_order_less(m.chunk, c); });
-    const ChunkMesh& m = *it;  // the owner always has this vertex: its cell has a sign change
+    const ChunkMesh& m = *find_sorted(chunks_, owner, n);  // the owner always has this vertex: its cell has a sign change
     auto begin = m.vertex_cell.begin(), end = begin + long(m.own_vertices);
     auto v = std::lower_bound(begin, end, cell, [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_order_less(a, b); });
-    return uint32_t(vbase[size_t(it - chunks_.begin())] + size_t(v - begin));
+    return uint32_t(vbase[size_t(&m - chunks_.data())] + size_t(v - begin));
   };
   ContourMesh out;
   out.positions.resize(vbase[n]);

@@ -42,11 +42,11 @@ bool finite_matrix(const glm::dmat4& m) {
 }  // namespace
 
 glm::dmat4& Brush::transform() {
-  return std::visit([](auto& shape) -> glm::dmat4& { return shape.transform; }, shape);
+  return std::visit([](auto& s) -> glm::dmat4& { return s.transform; }, shape);
 }
 
 const glm::dmat4& Brush::transform() const {
-  return std::visit([](const auto& shape) -> const glm::dmat4& { return shape.transform; }, shape);
+  return std::visit([](const auto& s) -> const glm::dmat4& { return s.transform; }, shape);
 }
 
 Brush Brush::sphere(const glm::dvec3& centre, double radius, uint16_t material) {

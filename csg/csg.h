@@ -35,6 +35,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <unordered_map>
 #include <variant>
@@ -194,7 +195,7 @@ class WorldEditor {
     EditOp op = EditOp::kSubtract;
   };
   // Applies edits in order, as one undo step; chunks in parallel.
-  Result<EditReceipt> apply_batch(const std::vector<Edit>& edits, Context* ctx = nullptr);
+  Result<EditReceipt> apply_batch(std::span<const Edit> edits, Context* ctx = nullptr);
 
   // Restores the chunks an edit changed. Undo in reverse order: refused (and
   // nothing changes) if a later edit changed one of the same chunks.

@@ -168,10 +168,11 @@ Result<WorldEditor> WorldEditor::create(World world, const BooleanConfig& config
 }
 
 Result<EditReceipt> WorldEditor::apply(const Brush& brush, EditOp op, Context* ctx) {
-  return apply_batch({Edit{brush, op}}, ctx);
+  const Edit one{brush, op};
+  return apply_batch(std::span<const Edit>(&one, 1), ctx);
 }
 
-Result<EditReceipt> WorldEditor::apply_batch(const std::vector<Edit>& edits, Context* ctx) {
+Result<EditReceipt> WorldEditor::apply_batch(std::span<const Edit> edits, Context* ctx) {
   ScopedTimer timer(ctx, "edit");
   Status s = check_boolean_config(config_);
   if (!s.ok()) return s;

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <map>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 
@@ -52,7 +53,7 @@ struct LiveState {
   CascadesId next_cascades_id = 1;
 
   std::map<glm::ivec3, ChunkChange, ChunkOrder> changes;        // since the last take_changes()
-  std::map<glm::ivec3, bool, ChunkOrder> dirty_since_update;    // chunks, since the last update()
+  std::set<glm::ivec3, ChunkOrder> dirty_since_update;           // chunks, since the last update()
 
   const World& world() const { return editor.world(); }
 
@@ -85,7 +86,7 @@ struct LiveState {
     }
     c.data = true;
     c.version = d.version;
-    dirty_since_update[d.chunk] = true;
+    dirty_since_update.insert(d.chunk);
   }
 
   void record_mesh_flags(std::span<const DirtyChunk> dirty) {
@@ -153,8 +154,7 @@ Result<EditReceipt> LiveWorld::apply(const Brush& brush, EditOp op, Context* ctx
 }
 
 Result<EditReceipt> LiveWorld::apply_batch(std::span<const WorldEditor::Edit> edits, Context* ctx) {
-  const std::vector<WorldEditor::Edit> list(edits.begin(), edits.end());
-  Result<EditReceipt> r = state_->editor.apply_batch(list, ctx);
+  Result<EditReceipt> r = state_->editor.apply_batch(edits, ctx);
   fan_out(state_->editor.take_dirty());
   return r;
 }
