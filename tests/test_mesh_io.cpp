@@ -11,13 +11,13 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <functional>
 #include <random>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "ldc/io.h"
 #include "ldc/mesh.h"
 #include "meshio/meshio.h"
 
@@ -1195,16 +1195,13 @@ TEST(MeshIo, TriangleLimitHoldsForBinaryContainers) {
 TEST(MeshIo, ARefusedSaveLeavesThePreviousFileIntact) {
   const std::string path = temp_file("keep.ply");
   ASSERT_TRUE(save_mesh(cube_mesh(), path).ok());
-  std::ifstream before_in(path, std::ios::binary);
-  const std::string before((std::istreambuf_iterator<char>(before_in)), std::istreambuf_iterator<char>());
+  const std::string before = read_file(path).value();
   TriangleMesh broken = cube_mesh();
   broken.triangles[3].y = 99;  // out of range
   Status s = save_mesh(broken, path);
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find(path), std::string::npos);
-  std::ifstream after_in(path, std::ios::binary);
-  const std::string after((std::istreambuf_iterator<char>(after_in)), std::istreambuf_iterator<char>());
-  EXPECT_EQ(after, before);
+  EXPECT_EQ(read_file(path).value(), before);
   EXPECT_FALSE(std::filesystem::exists(path + ".tmp"));
   std::remove(path.c_str());
 }
