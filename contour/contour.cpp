@@ -151,7 +151,8 @@ auto find_sorted(Chunks& chunks, const glm::ivec3& chunk, size_t end) -> decltyp
 }
 
 bool same_chunk_mesh(const ChunkMesh& a, const ChunkMesh& b) {
-  return a.own_vertices == b.own_vertices && a.vertex_cell == b.vertex_cell && a.mesh.positions == b.mesh.positions &&
+  return a.own_vertices == b.own_vertices && a.vertex_cell == b.vertex_cell && a.vertex_sheet == b.vertex_sheet &&
+         a.mesh.positions == b.mesh.positions &&
          a.mesh.normals == b.mesh.normals && a.mesh.vertex_material == b.mesh.vertex_material &&
          a.mesh.triangles == b.mesh.triangles && a.mesh.triangle_material == b.mesh.triangle_material;
 }
@@ -284,13 +285,13 @@ ContourMesh ChunkedMesh::assemble() const {
     vbase[i + 1] = vbase[i] + chunks_[i].own_vertices;
     tbase[i + 1] = tbase[i] + chunks_[i].mesh.triangles.size();
   }
-  auto global_index = [&](const glm::ivec3& cell) -> uint32_t {
+  auto global_index = [&](const glm::ivec3& cell, uint8_t sheet) -> uint32_t {
     glm::ivec3 owner(detail::floor_div(cell.x, chunk_size_), detail::floor_div(cell.y, chunk_size_),
                      detail::floor_div(cell.z, chunk_size_));
     const ChunkMesh& m = *find_sorted(chunks_, owner, n);  // the owner always has this vertex: its cell has a sign change
     auto begin = m.vertex_cell.begin(), end = begin + long(m.own_vertices);
     auto v = std::lower_bound(begin, end, cell, [](const glm::ivec3& a, const glm::ivec3& b) { return chunk_order_less(a, b); });
-    return uint32_t(vbase[size_t(&m - chunks_.data())] + size_t(v - begin));
+    return uint32_t(vbase[size_t(&m - chunks_.data())] + size_t(v - begin) + sheet);  // a cell's sheets are consecutive
   };
   ContourMesh out;
   out.positions.resize(vbase[n]);
@@ -305,7 +306,7 @@ ContourMesh ChunkedMesh::assemble() const {
     std::copy_n(m.mesh.vertex_material.begin(), m.own_vertices, out.vertex_material.begin() + long(vbase[i]));
     std::vector<uint32_t> map(m.mesh.positions.size());
     for (size_t v = 0; v < map.size(); ++v) {
-      map[v] = v < m.own_vertices ? uint32_t(vbase[i] + v) : global_index(m.vertex_cell[v]);
+      map[v] = v < m.own_vertices ? uint32_t(vbase[i] + v) : global_index(m.vertex_cell[v], m.vertex_sheet[v]);
     }
     for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
       const glm::uvec3& tri = m.mesh.triangles[t];

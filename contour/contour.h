@@ -2,10 +2,21 @@
 //
 // Every edge of a lattice cell is a segment of an LDC ray, so the surface
 // crossings on a cell's 12 edges, with their exact normals, are read straight
-// out of the span lists. One vertex per cell whose corners differ, placed by
-// the Hermite planes of its crossings; one quad per edge whose ends differ,
-// joining the four cells around it, split into two triangles and oriented
-// with its normal pointing out of the solid.
+// out of the span lists. One vertex per sheet of surface through a cell
+// (usually one sheet, whenever the cell's corners differ), placed by the
+// Hermite planes of the sheet's crossings; one quad per edge whose ends
+// differ, joining the sheets that hold the edge in the four cells around it,
+// split into two triangles and oriented with its normal pointing out of the
+// solid.
+//
+// Topology: the sheets of a cell come from its corners' signs alone, with
+// faces that hold two diagonal inside corners keeping them apart, the same
+// rule from both cells sharing a face (contour/detail/cell_sheets.h; the
+// dual of marching cubes on that table, as in Nielson's dual marching
+// cubes). So every vertex's triangles form one disk and every edge has two
+// triangles: the output is a closed 2-manifold wherever two cells sharing a
+// face are not joined through both segments of that face (a tunnel thinner
+// than a cell).
 //
 // Rules this module follows (documented choices):
 // - An edge with several crossings (an odd number when its ends differ)
@@ -141,6 +152,10 @@ struct ChunkMesh {
   ContourMesh mesh;
   size_t own_vertices = 0;          // mesh.positions[0 .. own_vertices) belong to this chunk
   std::vector<glm::ivec3> vertex_cell;  // the lattice cell of every vertex
+  // Which sheet of surface through its cell each vertex stands for: a cell
+  // that two or more separate sheets cross (a thin wall, two surfaces
+  // meeting at a corner) has a vertex per sheet, numbered from 0.
+  std::vector<uint8_t> vertex_sheet;
   // ChunkedMesh: the build or update that last changed this mesh (see
   // ChunkedMesh::version); an engine re-uploads a chunk whose version moved.
   uint64_t version = 0;

@@ -1,10 +1,8 @@
 // Marching cubes on LDC data, the baseline: vertices at the edge crossings,
-// normals unused for placement. Instead of the usual 256-case table, each
-// cube's polygons are traced face by face: walking a face counter-clockwise
-// seen from outside the cube, every run of inside corners gives one segment
-// from the crossing entering the run to the crossing leaving it (so a face
-// with two diagonal inside corners separates them, the same from both cubes
-// sharing the face). The segments close into loops, fanned into triangles.
+// normals unused for placement. Each cube's polygons are the loops of its
+// sheets (detail/cell_sheets.h, the table dual contouring uses too: faces
+// with two diagonal inside corners separate them, the same from both cubes
+// sharing the face), fanned into triangles.
 //
 // Welding: a vertex is a lattice edge's crossing, so it is named by the edge
 // (its lower node and axis). Chunks are meshed in parallel, each keeping the
@@ -21,38 +19,13 @@
 #include <tbb/parallel_for.h>
 
 #include "contour/contour.h"
+#include "contour/detail/cell_sheets.h"
 #include "contour/detail/region.h"
 
 namespace ldc {
 namespace {
 
-// Cube corners by bits (x, y, z); cube edges by (axis, offset of the lower corner).
-struct CubeEdge {
-  int axis;
-  glm::ivec3 offset;
-};
-
-// The six faces as corner loops, counter-clockwise seen from outside the cube.
-constexpr int kFaces[6][4] = {
-    {0, 4, 6, 2},  // x = 0: (0,0,0) (0,0,1) (0,1,1) (0,1,0), normal -x
-    {1, 3, 7, 5},  // x = 1
-    {0, 1, 5, 4},  // y = 0
-    {2, 6, 7, 3},  // y = 1
-    {0, 2, 3, 1},  // z = 0
-    {4, 5, 7, 6},  // z = 1
-};
-
 glm::ivec3 corner(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
-
-// The cube edge between two corners that differ in one coordinate.
-CubeEdge edge_between(int a, int b) {
-  glm::ivec3 pa = corner(a), pb = corner(b);
-  CubeEdge e;
-  for (int i = 0; i < 3; ++i)
-    if (pa[i] != pb[i]) e.axis = i;
-  e.offset = glm::min(pa, pb);
-  return e;
-}
 
 // A lattice edge relative to a chunk's first node (offsets 0 .. chunk size).
 uint32_t edge_key(const glm::ivec3& offset, int axis) {
@@ -73,70 +46,38 @@ class CubeMesher {
       : w_(w), r_(r), cell_lo_(cell_lo), part_(out), out_(out.mesh), ids_(out.ids) {}
 
   void cube(const glm::ivec3& cell) {
-    bool in[8];
-    int count = 0;
-    for (int c = 0; c < 8; ++c) count += in[c] = r_.inside(cell + corner(c));
-    if (count == 0 || count == 8) return;
-    // next[e] = the crossing that follows crossing e on the surface loop.
-    std::array<int, 12> next;
-    next.fill(-1);
-    std::array<uint32_t, 12> vertex_of;
-    for (const auto& f : kFaces) trace_face(cell, f, in, next, vertex_of);
-    emit_loops(next, vertex_of);
-  }
-
- private:
-  static int edge_slot(const CubeEdge& e) { return e.axis * 4 + e.offset[(e.axis + 1) % 3] + 2 * e.offset[(e.axis + 2) % 3]; }
-
-  uint32_t vertex(const glm::ivec3& cell, const CubeEdge& e) {
-    glm::ivec3 node = cell + e.offset;
-    const uint32_t key = edge_key(node - cell_lo_, e.axis);
-    auto it = ids_.find(key);
-    if (it != ids_.end()) return it->second;
-    const detail::EdgeCrossing* x = r_.crossing(e.axis, node);
-    glm::dvec3 p(node);
-    p[e.axis] += x->t;
-    uint32_t id = uint32_t(out_.positions.size());
-    out_.positions.push_back(w_.lattice().to_world(p));
-    out_.normals.push_back(x->normal);
-    out_.vertex_material.push_back(x->material);
-    part_.vertex_node.push_back(node);
-    part_.vertex_axis.push_back(uint8_t(e.axis));
-    ids_.emplace(key, id);
-    return id;
-  }
-
-  void trace_face(const glm::ivec3& cell, const int (&f)[4], const bool* in, std::array<int, 12>& next,
-                  std::array<uint32_t, 12>& vertex_of) {
-    for (int k = 0; k < 4; ++k) {
-      int a = f[k], b = f[(k + 1) % 4];
-      if (in[a] || !in[b]) continue;  // look for an edge entering a run of inside corners
-      int j = (k + 1) % 4;
-      while (in[f[(j + 1) % 4]]) j = (j + 1) % 4;  // the run ends at corner f[j]
-      CubeEdge enter = edge_between(a, b), leave = edge_between(f[j], f[(j + 1) % 4]);
-      int s = edge_slot(enter), t = edge_slot(leave);
-      vertex_of[s] = vertex(cell, enter);
-      vertex_of[t] = vertex(cell, leave);
-      next[s] = t;
-    }
-  }
-
-  void emit_loops(std::array<int, 12>& next, const std::array<uint32_t, 12>& vertex_of) {
-    for (int start = 0; start < 12; ++start) {
-      if (next[start] < 0) continue;
-      std::array<uint32_t, 12> loop;
-      int n = 0;
-      for (int e = start; e >= 0 && n < 12;) {
-        loop[n++] = vertex_of[e];
-        int following = next[e];
-        next[e] = -1;
-        e = following == start ? -1 : following;
-      }
+    unsigned inside = 0;
+    for (int c = 0; c < 8; ++c) inside |= unsigned(r_.inside(cell + corner(c))) << c;
+    const detail::CellSheets& sheets = detail::cell_sheets(inside);
+    for (int s = 0; s < sheets.count; ++s) {
+      uint32_t loop[12];
+      const int n = sheets.loop_size[s];
+      for (int i = 0; i < n; ++i) loop[i] = vertex(cell, sheets.loop[s][i]);
       for (int i = 1; i + 1 < n; ++i) {
         out_.triangles.push_back({loop[0], loop[i], loop[i + 1]});
         out_.triangle_material.push_back(out_.vertex_material[loop[0]]);
       }
     }
+  }
+
+ private:
+  uint32_t vertex(const glm::ivec3& cell, int slot) {
+    const int axis = detail::cell_edge_axis(slot);
+    const glm::ivec3 node = cell + detail::cell_edge_offset(slot);
+    const uint32_t key = edge_key(node - cell_lo_, axis);
+    auto it = ids_.find(key);
+    if (it != ids_.end()) return it->second;
+    const detail::EdgeCrossing* x = r_.crossing(axis, node);
+    glm::dvec3 p(node);
+    p[axis] += x->t;
+    uint32_t id = uint32_t(out_.positions.size());
+    out_.positions.push_back(w_.lattice().to_world(p));
+    out_.normals.push_back(x->normal);
+    out_.vertex_material.push_back(x->material);
+    part_.vertex_node.push_back(node);
+    part_.vertex_axis.push_back(uint8_t(axis));
+    ids_.emplace(key, id);
+    return id;
   }
 
   const World& w_;

@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include "contour/detail/cell_sheets.h"
 #include "contour/detail/region_mesher.h"
 
 namespace ldc::detail {
@@ -17,6 +18,11 @@ bool cell_less(const glm::ivec3& a, const glm::ivec3& b) {
   if (a.z != b.z) return a.z < b.z;
   if (a.y != b.y) return a.y < b.y;
   return a.x < b.x;
+}
+
+// Vertices are named by cell and sheet, sorted by cell then sheet.
+bool vertex_less(const glm::ivec3& a, uint8_t sa, const glm::ivec3& b, uint8_t sb) {
+  return a != b ? cell_less(a, b) : sa < sb;
 }
 
 bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
@@ -30,7 +36,7 @@ glm::ivec3 edge_node(const glm::ivec3 (&cell)[3]) {
 }
 
 // Cells around the edges a chunk owns lie in [own_lo - 1, own_hi): a dense
-// index over that box maps a cell to a vertex. The slots live in a buffer
+// index over that box (a slot per sheet) maps a cell's sheet to a vertex. The slots live in a buffer
 // kept per thread and per slot (two per splice), all -1 between uses: only
 // the slots a splice set are reset, so a splice does not pay for clearing or
 // faulting in (C + 1)^3 slots (that was most of a small edit's splice).
@@ -39,7 +45,7 @@ glm::ivec3 edge_node(const glm::ivec3 (&cell)[3]) {
 class CellIndex {
  public:
   CellIndex(const glm::ivec3& lo, int size, int slot) : lo_(lo), n_(size), index_(buffer(slot)) {
-    const size_t cells = size_t(size) * size * size;
+    const size_t cells = size_t(size) * size * size * CellSheets::kMaxSheets;
     if (index_.size() < cells) index_.assign(cells, -1);
   }
   ~CellIndex() {
@@ -48,9 +54,9 @@ class CellIndex {
   CellIndex(const CellIndex&) = delete;
   CellIndex& operator=(const CellIndex&) = delete;
 
-  int32_t get(const glm::ivec3& cell) const { return index_[offset(cell)]; }
-  void set(const glm::ivec3& cell, int32_t value) {
-    size_t i = offset(cell);
+  int32_t get(const glm::ivec3& cell, uint8_t sheet) const { return index_[offset(cell, sheet)]; }
+  void set(const glm::ivec3& cell, uint8_t sheet, int32_t value) {
+    size_t i = offset(cell, sheet);
     if (index_[i] < 0) touched_.push_back(i);
     index_[i] = value;
   }
@@ -61,9 +67,9 @@ class CellIndex {
     thread_local std::vector<int32_t> buffers[2];
     return buffers[slot];
   }
-  size_t offset(const glm::ivec3& cell) const {
+  size_t offset(const glm::ivec3& cell, uint8_t sheet) const {
     glm::ivec3 r = cell - lo_;
-    return (size_t(r.z) * n_ + size_t(r.y)) * n_ + size_t(r.x);
+    return ((size_t(r.z) * n_ + size_t(r.y)) * n_ + size_t(r.x)) * CellSheets::kMaxSheets + sheet;
   }
 
   glm::ivec3 lo_;
@@ -75,6 +81,7 @@ class CellIndex {
 // Where a vertex of the spliced chunk comes from.
 struct VertexSource {
   glm::ivec3 cell;
+  uint8_t sheet;
   bool from_patch;
   size_t index;  // into the patch's arrays or the old mesh's
 };
@@ -108,6 +115,7 @@ MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm:
     const ChunkMesh& m = pieces[s];
     for (size_t v = 0; v < m.own_vertices; ++v) {
       p.cells.push_back(m.vertex_cell[v]);
+      p.sheets.push_back(m.vertex_sheet[v]);
       p.positions.push_back(m.mesh.positions[v]);
       p.normals.push_back(m.mesh.normals[v]);
       p.materials.push_back(m.mesh.vertex_material[v]);
@@ -115,6 +123,7 @@ MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm:
     for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
       const glm::uvec3& tri = m.mesh.triangles[t];
       p.triangles.push_back({{m.vertex_cell[tri.x], m.vertex_cell[tri.y], m.vertex_cell[tri.z]},
+                             {m.vertex_sheet[tri.x], m.vertex_sheet[tri.y], m.vertex_sheet[tri.z]},
                              m.mesh.triangle_material[t]});
     }
     stats.add_counts(piece_stats[s]);
@@ -134,6 +143,7 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   for (size_t t = 0; t < old.mesh.triangles.size(); ++t) {
     const glm::uvec3& i = old.mesh.triangles[t];
     MeshPatch::Triangle tri{{old.vertex_cell[i.x], old.vertex_cell[i.y], old.vertex_cell[i.z]},
+                            {old.vertex_sheet[i.x], old.vertex_sheet[i.y], old.vertex_sheet[i.z]},
                             old.mesh.triangle_material[t]};
     if (!in_box(edge_node(tri.cell), patch.lo, patch.hi)) tris.push_back(tri);
   }
@@ -158,21 +168,21 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   while (true) {
     bool has_p = next_patch_own(), has_o = next_old_own();
     if (!has_p && !has_o) break;
-    if (has_p && (!has_o || cell_less(patch.cells[p], old.vertex_cell[o]))) {
-      sources.push_back({patch.cells[p], true, p});
+    if (has_p && (!has_o || vertex_less(patch.cells[p], patch.sheets[p], old.vertex_cell[o], old.vertex_sheet[o]))) {
+      sources.push_back({patch.cells[p], patch.sheets[p], true, p});
       ++p;
     } else {
-      sources.push_back({old.vertex_cell[o], false, o});
+      sources.push_back({old.vertex_cell[o], old.vertex_sheet[o], false, o});
       ++o;
     }
   }
   const size_t own = sources.size();
   // Copies of the neighbours' vertices the triangles use, in first-use order.
   CellIndex index(own_lo - 1, chunk_size + 1, 0);
-  for (size_t v = 0; v < own; ++v) index.set(sources[v].cell, int32_t(v));
+  for (size_t v = 0; v < own; ++v) index.set(sources[v].cell, sources[v].sheet, int32_t(v));
   CellIndex old_index(own_lo - 1, chunk_size + 1, 1);
   for (size_t v = 0; v < old.vertex_cell.size(); ++v) {
-    if (old_index.contains(old.vertex_cell[v])) old_index.set(old.vertex_cell[v], int32_t(v));
+    if (old_index.contains(old.vertex_cell[v])) old_index.set(old.vertex_cell[v], old.vertex_sheet[v], int32_t(v));
   }
   ChunkMesh out;
   out.chunk = chunk;
@@ -181,15 +191,17 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   for (const MeshPatch::Triangle& tri : tris) {
     glm::uvec3 ids;
     for (int j = 0; j < 3; ++j) {
-      int32_t id = index.get(tri.cell[j]);
+      const glm::ivec3& cell = tri.cell[j];
+      const uint8_t sheet = tri.sheet[j];
+      int32_t id = index.get(cell, sheet);
       if (id < 0) {
         id = int32_t(sources.size());
-        index.set(tri.cell[j], id);
-        if (in_box(tri.cell[j], patch.lo, patch.hi)) {
-          auto it = std::lower_bound(patch.cells.begin(), patch.cells.end(), tri.cell[j], cell_less);
-          sources.push_back({tri.cell[j], true, size_t(it - patch.cells.begin())});
+        index.set(cell, sheet, id);
+        if (in_box(cell, patch.lo, patch.hi)) {
+          auto it = std::lower_bound(patch.cells.begin(), patch.cells.end(), cell, cell_less);
+          sources.push_back({cell, sheet, true, size_t(it - patch.cells.begin()) + sheet});
         } else {
-          sources.push_back({tri.cell[j], false, size_t(old_index.get(tri.cell[j]))});
+          sources.push_back({cell, sheet, false, size_t(old_index.get(cell, sheet))});
         }
       }
       ids[j] = uint32_t(id);
@@ -200,6 +212,7 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   out.own_vertices = own;
   for (const VertexSource& s : sources) {
     out.vertex_cell.push_back(s.cell);
+    out.vertex_sheet.push_back(s.sheet);
     out.mesh.positions.push_back(s.from_patch ? patch.positions[s.index] : old.mesh.positions[s.index]);
     out.mesh.normals.push_back(s.from_patch ? patch.normals[s.index] : old.mesh.normals[s.index]);
     out.mesh.vertex_material.push_back(s.from_patch ? patch.materials[s.index] : old.mesh.vertex_material[s.index]);

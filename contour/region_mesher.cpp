@@ -31,9 +31,25 @@ size_t RegionMesher::cell_index(const glm::ivec3& cell) const {
   return (size_t(r.z) * s.y + size_t(r.y)) * s.x + size_t(r.x);
 }
 
-const RegionMesher::CellVertex* RegionMesher::vertex(const glm::ivec3& cell) const {
+int32_t RegionMesher::vertex_index(const glm::ivec3& cell, int sheet) const {
   int32_t i = cell_vertex_[cell_index(cell)];  // callers stay inside the cell box
+  return i < 0 ? -1 : i + sheet;
+}
+
+const RegionMesher::CellVertex* RegionMesher::vertex(const glm::ivec3& cell, int sheet) const {
+  int32_t i = vertex_index(cell, sheet);
   return i < 0 ? nullptr : &verts_[size_t(i)];
+}
+
+unsigned RegionMesher::inside_corners(const glm::ivec3& cell) const {
+  unsigned bits = 0;
+  for (int c = 0; c < 8; ++c) bits |= unsigned(region_.inside(cell + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2))) << c;
+  return bits;
+}
+
+uint8_t RegionMesher::sheet_of(const glm::ivec3& cell, int axis, const glm::ivec3& node) const {
+  const CellSheets& sheets = cell_sheets(cell_corners_[cell_index(cell)]);
+  return uint8_t(sheets.sheet_of_edge[cell_edge_slot(axis, node - cell)]);
 }
 
 // The quad of the edge from `node` along `axis`, if its ends differ: the four
@@ -45,20 +61,20 @@ bool RegionMesher::edge_quad(int axis, const glm::ivec3& node, Quad* quad) const
   // Counter-clockwise seen from +axis (u x v = axis); reversed when +axis is inside.
   glm::ivec3 cells[4] = {node - eu - ev, node - ev, node, node - eu};
   bool outward_plus = region_.inside(node);
-  for (int i = 0; i < 4; ++i) quad->cell[i] = outward_plus ? cells[i] : cells[3 - i];
+  for (int i = 0; i < 4; ++i) {
+    quad->cell[i] = outward_plus ? cells[i] : cells[3 - i];
+    quad->sheet[i] = in_cell_box(quad->cell[i]) ? sheet_of(quad->cell[i], axis, node) : 0;
+  }
   quad->material = x->material;
   return true;
 }
 
-// The quads around a cell's vertex: one per edge of the cell whose ends differ.
-int RegionMesher::cell_quads(const glm::ivec3& cell, Quad* quads) const {
+int RegionMesher::vertex_quads(const CellVertex& v, Quad* quads) const {
+  const CellSheets& sheets = cell_sheets(cell_corners_[cell_index(v.cell)]);
   int n = 0;
-  for (int a = 0; a < 3; ++a) {
-    const glm::ivec3 eu = unit(axis_u(a)), ev = unit(axis_v(a));
-    for (int k = 0; k < 4; ++k) {
-      glm::ivec3 node = cell + ((k & 1) ? eu : glm::ivec3(0)) + ((k & 2) ? ev : glm::ivec3(0));
-      if (edge_quad(a, node, &quads[n])) ++n;
-    }
+  for (int slot = 0; slot < 12; ++slot) {
+    if (sheets.sheet_of_edge[slot] != v.sheet) continue;
+    if (edge_quad(cell_edge_axis(slot), v.cell + cell_edge_offset(slot), &quads[n])) ++n;
   }
   return n;
 }
@@ -70,7 +86,7 @@ void RegionMesher::split(const Quad& q, int tri[2][3]) const {
   glm::dvec3 p[4];
   const glm::ivec3 frame = q.cell[0];
   for (int i = 0; i < 4; ++i) {
-    v[i] = vertex(q.cell[i]);
+    v[i] = vertex(q.cell[i], q.sheet[i]);
     p[i] = glm::dvec3(q.cell[i] - frame) + v[i]->x;
   }
   glm::dvec3 m02 = 0.5 * (p[0] + p[2]), m13 = 0.5 * (p[1] + p[3]);
@@ -106,16 +122,17 @@ std::vector<uint8_t> RegionMesher::cells_with_vertex() const {
   return marked;
 }
 
-// The crossings on the cell's 12 edges, in a fixed order (axis, then the
-// edge's offset in u and v), with positions relative to the cell's lowest node.
-CellPlanes RegionMesher::planes_of(const glm::ivec3& cell) const {
+// The crossings on the edges of one sheet of the cell, in a fixed order
+// (axis, then the edge's offset in u and v), with positions relative to the
+// cell's lowest node.
+CellPlanes RegionMesher::planes_of(const glm::ivec3& cell, const CellSheets& sheets, int sheet) const {
   const glm::dvec3 base(0.0);
   CellPlanes planes;
   for (int a = 0; a < 3; ++a) {
     const EdgeCrossing* edges[4];
     region_.cell_edges(a, cell, edges);
     for (int k = 0; k < 4; ++k) {
-      if (!edges[k]) continue;
+      if (!edges[k] || sheets.sheet_of_edge[a * 4 + k] != sheet) continue;
       glm::dvec3 p = base;
       p[axis_u(a)] += k & 1;
       p[axis_v(a)] += (k >> 1) & 1;
@@ -127,36 +144,51 @@ CellPlanes RegionMesher::planes_of(const glm::ivec3& cell) const {
 }
 
 // Every vertex the box's quads use is placed; in the relaxation margin
-// beyond them only border vertices are, as relaxation reads no others.
+// beyond them only cells with a border vertex are, as relaxation reads no
+// others. A cell's sheets get consecutive vertices.
 void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi, ContourStats& stats) {
   std::vector<uint8_t> marked = cells_with_vertex();
   cell_vertex_.assign(marked.size(), -1);
+  cell_corners_.assign(marked.size(), 0);
   verts_.clear();
   border_.clear();
   size_t i = 0;
+  CellPlanes planes[CellSheets::kMaxSheets];
   for (int z = cell_lo_.z; z < cell_hi_.z; ++z) {
     for (int y = cell_lo_.y; y < cell_hi_.y; ++y) {
       for (int x = cell_lo_.x; x < cell_hi_.x; ++x, ++i) {
         if (!marked[i]) continue;
-        glm::ivec3 cell(x, y, z);
-        CellPlanes planes = planes_of(cell);
-        if (!planes.mixed_materials() && !in_box(cell, used_lo, used_hi)) continue;
-        CellVertex v;
-        v.cell = cell;
-        v.qef = Qef::of(planes);
-        PlacedVertex pv = place_vertex(planes, v.qef, glm::dvec3(0.0), config_);
-        v.x = pv.position;
-        v.material = planes.majority_material();
-        v.normal = planes.mean_normal();
-        v.border = planes.mixed_materials();
-        if (v.border) border_.push_back(cell);
+        const glm::ivec3 cell(x, y, z);
+        const unsigned corners = inside_corners(cell);
+        const CellSheets& sheets = cell_sheets(corners);
+        bool any_border = false;
+        for (int s = 0; s < sheets.count; ++s) {
+          planes[s] = planes_of(cell, sheets, s);
+          any_border = any_border || planes[s].mixed_materials();
+        }
+        if (!any_border && !in_box(cell, used_lo, used_hi)) continue;
         cell_vertex_[i] = int32_t(verts_.size());
-        verts_.push_back(v);
-        if (config_.placement == Placement::kQef) ++stats.qef_rank[pv.rank];
-        stats.clamped_vertices += pv.clamped;
+        cell_corners_[i] = uint8_t(corners);
+        for (int s = 0; s < sheets.count; ++s) add_vertex(cell, s, planes[s], stats);
       }
     }
   }
+}
+
+void RegionMesher::add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes, ContourStats& stats) {
+  CellVertex v;
+  v.cell = cell;
+  v.sheet = uint8_t(sheet);
+  v.qef = Qef::of(planes);
+  PlacedVertex pv = place_vertex(planes, v.qef, glm::dvec3(0.0), config_);
+  v.x = pv.position;
+  v.material = planes.majority_material();
+  v.normal = planes.mean_normal();
+  v.border = planes.mixed_materials();
+  if (v.border) border_.push_back(uint32_t(verts_.size()));
+  verts_.push_back(v);
+  if (config_.placement == Placement::kQef) ++stats.qef_rank[pv.rank];
+  stats.clamped_vertices += pv.clamped;
 }
 
 // Elastic net on material borders: every border vertex moves towards the mean
@@ -167,18 +199,18 @@ void RegionMesher::relax() {
   if (config_.relax_iterations <= 0 || config_.relax_strength <= 0.0) return;
   std::vector<glm::dvec3> next(border_.size());
   for (int it = 0; it < config_.relax_iterations; ++it) {
-    for (size_t b = 0; b < border_.size(); ++b) next[b] = relaxed_position(border_[b]);
-    for (size_t b = 0; b < border_.size(); ++b) verts_[size_t(cell_vertex_[cell_index(border_[b])])].x = next[b];
+    for (size_t b = 0; b < border_.size(); ++b) next[b] = relaxed_position(verts_[border_[b]]);
+    for (size_t b = 0; b < border_.size(); ++b) verts_[border_[b]].x = next[b];
   }
 }
 
 // The elastic step, in the vertex's own cell frame: towards the mean of its
 // border neighbours, then back onto its planes (a few particle steps), and
 // into its cell.
-glm::dvec3 RegionMesher::relaxed_position(const glm::ivec3& cell) const {
-  const CellVertex& v = *vertex(cell);
+glm::dvec3 RegionMesher::relaxed_position(const CellVertex& v) const {
+  const glm::ivec3& cell = v.cell;
   Quad quads[12];
-  int n = cell_quads(cell, quads);
+  int n = vertex_quads(v, quads);
   glm::dvec3 sum(0.0);
   int count = 0;
   for (int k = 0; k < n; ++k) {
@@ -187,7 +219,7 @@ glm::dvec3 RegionMesher::relaxed_position(const glm::ivec3& cell) const {
     for (int side : {1, 3}) {
       const glm::ivec3& other = quads[k].cell[(at + side) % 4];
       if (!in_cell_box(other)) continue;
-      const CellVertex* nb = vertex(other);
+      const CellVertex* nb = vertex(other, quads[k].sheet[(at + side) % 4]);
       if (nb && nb->border) {
         sum += glm::dvec3(other - cell) + nb->x;
         ++count;
@@ -209,13 +241,14 @@ void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
                         ContourStats& stats, bool order_triangles) {
   std::vector<int32_t> out_index(verts_.size(), -1);
   ContourMesh& m = out.mesh;
-  auto add_vertex = [&](const glm::ivec3& cell) {
-    out_index[size_t(cell_vertex_[cell_index(cell)])] = int32_t(m.positions.size());
-    out.vertex_cell.push_back(cell);
+  auto add_vertex = [&](size_t vi) {
+    out_index[vi] = int32_t(m.positions.size());
+    out.vertex_cell.push_back(verts_[vi].cell);
+    out.vertex_sheet.push_back(verts_[vi].sheet);
     m.positions.push_back(glm::dvec3(0.0));  // filled by finish_vertices
   };
-  for (const CellVertex& v : verts_) {  // in cell order (z, y, x)
-    if (in_box(v.cell, own_lo, own_hi)) add_vertex(v.cell);
+  for (size_t vi = 0; vi < verts_.size(); ++vi) {  // in cell order (z, y, x), then sheet
+    if (in_box(verts_[vi].cell, own_lo, own_hi)) add_vertex(vi);
   }
   out.own_vertices = m.positions.size();
   for (const Region::EdgeRef& e : region_.crossing_edges()) {
@@ -227,8 +260,8 @@ void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
     for (const auto& t : tri) {
       uint32_t idx[3];
       for (int j = 0; j < 3; ++j) {
-        int32_t vi = cell_vertex_[cell_index(q.cell[t[j]])];
-        if (out_index[size_t(vi)] < 0) add_vertex(q.cell[t[j]]);
+        const size_t vi = size_t(vertex_index(q.cell[t[j]], q.sheet[t[j]]));
+        if (out_index[vi] < 0) add_vertex(vi);
         idx[j] = uint32_t(out_index[size_t(vi)]);
       }
       m.triangles.push_back({idx[0], idx[1], idx[2]});
@@ -274,7 +307,7 @@ void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
   m.normals.resize(m.positions.size());
   m.vertex_material.resize(m.positions.size());
   for (size_t i = 0; i < m.positions.size(); ++i) {
-    const CellVertex& v = *vertex(out.vertex_cell[i]);
+    const CellVertex& v = *vertex(out.vertex_cell[i], out.vertex_sheet[i]);
     m.positions[i] = lat.to_world(glm::dvec3(v.cell) + v.x);
     m.normals[i] = v.normal;
     m.vertex_material[i] = v.material;
@@ -305,6 +338,7 @@ void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
                         ContourStats& stats, bool order_triangles) {
   out.mesh = {};
   out.vertex_cell.clear();
+  out.vertex_sheet.clear();
   out.own_vertices = 0;
   // Quads need the cells one below; relaxation one more cell per iteration on
   // every side, but only where materials meet.

@@ -21,13 +21,15 @@ namespace ldc::detail {
 
 struct MeshPatch {
   glm::ivec3 lo{0}, hi{0};  // the cells and edge nodes it replaces (hi exclusive)
-  // Every cell of the box with a vertex, sorted (z, y, x), and its data.
+  // Every vertex of the box's cells, sorted by cell (z, y, x) then sheet, and its data.
   std::vector<glm::ivec3> cells;
+  std::vector<uint8_t> sheets;
   std::vector<glm::dvec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<uint16_t> materials;
   struct Triangle {
     glm::ivec3 cell[3];
+    uint8_t sheet[3];
     uint16_t material = 0;
   };
   std::vector<Triangle> triangles;  // of every edge whose lower node is in the box

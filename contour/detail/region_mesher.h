@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "contour/contour.h"
+#include "contour/detail/cell_sheets.h"
 #include "contour/detail/placement.h"
 #include "contour/detail/region.h"
 
@@ -29,29 +30,38 @@ class RegionMesher {
  private:
   struct CellVertex {
     glm::ivec3 cell{0};
+    uint8_t sheet = 0;  // which sheet of surface through the cell (detail/cell_sheets.h)
     glm::dvec3 x{0.0};  // lattice coordinates relative to the cell's lowest node
     Qef qef;
     glm::vec3 normal{0.0f};  // mean of its crossings' normals
     uint16_t material = 0;
     bool border = false;  // its quads have different materials
   };
+  // The vertices of a quad: a sheet in each of the four cells around an edge.
   struct Quad {
     glm::ivec3 cell[4];  // counter-clockwise seen from outside
+    uint8_t sheet[4];
     uint16_t material = 0;
   };
 
   void load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int low, int high);
   bool single_material() const;
   std::vector<uint8_t> cells_with_vertex() const;
-  CellPlanes planes_of(const glm::ivec3& cell) const;
+  unsigned inside_corners(const glm::ivec3& cell) const;
+  // The sheet of `cell` that holds the edge from `node` along `axis` (a crossing edge of the cell).
+  uint8_t sheet_of(const glm::ivec3& cell, int axis, const glm::ivec3& node) const;
+  CellPlanes planes_of(const glm::ivec3& cell, const CellSheets& sheets, int sheet) const;
   void place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi, ContourStats& stats);
+  void add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes, ContourStats& stats);
   void relax();
-  glm::dvec3 relaxed_position(const glm::ivec3& cell) const;
+  glm::dvec3 relaxed_position(const CellVertex& v) const;
   bool edge_quad(int axis, const glm::ivec3& node, Quad* quad) const;
-  int cell_quads(const glm::ivec3& cell, Quad* quads) const;
+  // The quads around one vertex: one per crossing edge of its sheet.
+  int vertex_quads(const CellVertex& v, Quad* quads) const;
   // Triangle corners (indices into quad.cell) after the diagonal rule.
   void split(const Quad& q, int tri[2][3]) const;
-  const CellVertex* vertex(const glm::ivec3& cell) const;
+  int32_t vertex_index(const glm::ivec3& cell, int sheet) const;
+  const CellVertex* vertex(const glm::ivec3& cell, int sheet) const;
   size_t cell_index(const glm::ivec3& cell) const;
   bool in_cell_box(const glm::ivec3& cell) const;
   void emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats,
@@ -62,9 +72,10 @@ class RegionMesher {
   ContourConfig config_;
   Region region_;
   glm::ivec3 cell_lo_{0}, cell_hi_{0};
-  std::vector<int32_t> cell_vertex_;  // index into verts_, -1 without a vertex
+  std::vector<int32_t> cell_vertex_;   // index into verts_ of the cell's sheet 0 (its sheets follow), -1 without
+  std::vector<uint8_t> cell_corners_;  // inside corners of every cell with a vertex
   std::vector<CellVertex> verts_;
-  std::vector<glm::ivec3> border_;  // cells whose vertex is on a material border
+  std::vector<uint32_t> border_;  // vertices on a material border
 };
 
 }  // namespace ldc::detail

@@ -1,0 +1,49 @@
+// The sheets of surface through one lattice cell, from the signs of its eight
+// corners alone: what makes the contoured mesh a 2-manifold.
+//
+// Each face of the cell pairs the crossings on its edges into segments: a
+// face with two crossings joins them; a face with four (two inside corners on
+// one diagonal) joins the crossings around each inside corner, so the two
+// inside corners are kept apart. The rule reads only the face's corners, so
+// both cells sharing a face pair its crossings the same way. Every crossing
+// lies on two faces of the cell, so the segments close into loops; each loop
+// bounds one disk of surface in the cell: a sheet. Dual contouring places one
+// vertex per sheet (not per cell), and the quad of a crossing edge joins, in
+// each of its four cells, the sheet that holds that edge. Then every vertex's
+// triangles form one disk, and two cells sharing a face are joined by one
+// mesh edge per face segment.
+//
+// Corners are numbered by bits (x, y, z); a cell's 12 edges by slot
+// axis * 4 + k, where k = (offset along axis_u(axis)) + 2 * (offset along
+// axis_v(axis)) of the edge's lower corner.
+#pragma once
+
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+namespace ldc::detail {
+
+struct CellSheets {
+  static constexpr int kMaxSheets = 4;
+  uint8_t count = 0;         // sheets through the cell (0 when all corners agree)
+  int8_t sheet_of_edge[12];  // the sheet holding each edge's crossing; -1 when its ends agree
+  // The edge slots around each sheet's loop, in order: counter-clockwise seen
+  // from the outside of the solid (so a fan over them faces outwards).
+  uint8_t loop_size[kMaxSheets];
+  uint8_t loop[kMaxSheets][12];
+};
+
+// The table entry for a cell whose inside corners are the set bits.
+const CellSheets& cell_sheets(unsigned inside_corners);
+
+// The lower corner's offset in the cell, and the axis, of edge slot `slot`.
+glm::ivec3 cell_edge_offset(int slot);
+inline int cell_edge_axis(int slot) { return slot / 4; }
+
+// The slot of the edge along `axis` whose lower corner is at `offset` (each 0 or 1).
+inline int cell_edge_slot(int axis, const glm::ivec3& offset) {
+  return axis * 4 + offset[(axis + 1) % 3] + 2 * offset[(axis + 2) % 3];
+}
+
+}  // namespace ldc::detail
