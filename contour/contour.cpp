@@ -100,11 +100,11 @@ Result<std::vector<ChunkMesh>> mesh_chunks(const World& w, const std::vector<glm
 // The boxes to re-mesh for a dirty list: each dirty node box grown to the
 // cells and edges it can affect, overlapping boxes merged (an edit's boxes
 // come one per chunk and meet).
-std::vector<std::pair<glm::ivec3, glm::ivec3>> patch_boxes(std::span<const DirtyChunk> dirty, int relax) {
+std::vector<std::pair<glm::ivec3, glm::ivec3>> patch_boxes(std::span<const DirtyChunk> dirty, int reach) {
   std::vector<std::pair<glm::ivec3, glm::ivec3>> boxes;
   for (const DirtyChunk& d : dirty) {
     glm::ivec3 lo, hi;
-    detail::patch_box(d.node_lo, d.node_hi, relax, &lo, &hi);
+    detail::patch_box(d.node_lo, d.node_hi, reach, &lo, &hi);
     boxes.emplace_back(lo, hi);
   }
   auto overlap = [](const auto& a, const auto& b) {
@@ -164,7 +164,7 @@ std::vector<glm::ivec3> chunks_a_remesh_may_change(std::span<const DirtyChunk> d
   std::vector<glm::ivec3> chunks;
   for (const DirtyChunk& d : dirty) {
     glm::ivec3 lo, hi;
-    detail::patch_box(d.node_lo, d.node_hi, config.relax_iterations, &lo, &hi);
+    detail::patch_box(d.node_lo, d.node_hi, detail::RegionMesher::vertex_reach(config), &lo, &hi);
     chunks_of_box(lo, hi, chunk_size, chunks);
   }
   sort_unique_chunks(chunks);
@@ -230,7 +230,7 @@ Result<MeshUpdate> ChunkedMesh::update(const World& world, std::span<const Dirty
   ContourStats stats;
   MeshUpdate result;
   std::vector<glm::ivec3> changed;
-  for (const auto& [lo, hi] : patch_boxes(dirty, config_.relax_iterations)) {
+  for (const auto& [lo, hi] : patch_boxes(dirty, detail::RegionMesher::vertex_reach(config_))) {
     if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "contour: cancelled");
     detail::MeshPatch patch = detail::mesh_patch(world, config_, lo, hi, stats);
     result.chunks_remeshed += splice(patch, changed);
@@ -344,6 +344,7 @@ void ContourStats::add_counts(const ContourStats& s) {
   thin_edges += s.thin_edges;
   clamped_vertices += s.clamped_vertices;
   relaxed_vertices += s.relaxed_vertices;
+  untangled_vertices += s.untangled_vertices;
   for (int i = 0; i < 4; ++i) qef_rank[i] += s.qef_rank[i];
 }
 

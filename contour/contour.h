@@ -107,6 +107,15 @@ struct ContourConfig {
   int relax_iterations = 4;        // [Limit: 0 .. 16]; 0 turns it off
   double relax_strength = 0.5;     // [Limit: [0, 1]]
   double relax_plane_pull = 1.0;   // [Limit: [0, 1]]
+  // Self-intersections: placement for sharp features can fold a vertex's
+  // triangles through its neighbours'. With untangle, the vertices within a
+  // cell of any intersecting triangle pair go to their mass points (the mean
+  // of their crossings), where folds all but vanish; sharp features are kept
+  // everywhere else (contour/untangle.cpp; ContourStats::untangled_vertices
+  // counts the moves, mesh_quality what is left). It reads placed vertices
+  // 4 + ceil(2 cell_slack) cells around each vertex, so chunks and edits
+  // re-mesh that much margin.
+  bool untangle = true;
   // Mesh the world chunk by chunk in parallel (the default), or in one
   // piece (for tests; refuses worlds larger than 256 cells along an axis).
   bool chunked = true;
@@ -135,6 +144,7 @@ struct ContourStats {
   size_t thin_edges = 0;             // edges with crossings but equal ends (ignored)
   size_t clamped_vertices = 0;       // vertices the cell (plus slack) held back from their planes' optimum
   size_t relaxed_vertices = 0;       // vertices on a material border
+  size_t untangled_vertices = 0;     // vertices moved to their mass point by untangling
   size_t qef_rank[4] = {0, 0, 0, 0};  // kQef: how many cells solved with rank 0..3
 
   // Adds another run's counts to these (seconds are left as they are).
@@ -176,8 +186,8 @@ struct MeshUpdate {
 };
 
 // The chunks whose meshes an update for `dirty` may change: every chunk a
-// re-mesh box (the dirty node box grown by relax_iterations + 1 cells, plus
-// the quads around it) overlaps, sorted by chunk_order_less. Meshes outside
+// re-mesh box (the dirty node box grown by relax_iterations + 1 cells, and
+// 4 + ceil(2 cell_slack) more with untangle, plus the quads around it) overlaps, sorted by chunk_order_less. Meshes outside
 // them are untouched; an engine can mark these before re-meshing.
 std::vector<glm::ivec3> chunks_a_remesh_may_change(std::span<const DirtyChunk> dirty, const ContourConfig& config,
                                                    int chunk_size);
@@ -203,7 +213,7 @@ class ChunkedMesh {
   Result<MeshUpdate> update(const World& world, std::span<const glm::ivec3> changed_chunks,
                             Context* ctx = nullptr);
   // Re-meshes only the cells whose vertices the dirty boxes can move (each
-  // box grown by relax_iterations + 1 cells) and the quads around them, and
+  // box grown by relax_iterations + 1 cells, and the untangle margin) and the quads around them, and
   // splices them into the chunk meshes they fall in; the result equals a
   // fresh build. Returns the chunk meshes whose content changed or that were
   // removed; on error (cancelled) the meshes spliced so far stay spliced.
@@ -288,5 +298,109 @@ MeshQuality mesh_quality(const ContourMesh& mesh);
 // What keeps the mesh from being closed(), e.g. "12 boundary edges, 3
 // non-manifold vertices, 40 self-intersecting triangle pairs"; "" when closed.
 std::string quality_failures(const MeshQuality& quality);
+
+// --- Adaptive output: simplification within an error bound ---------------------
+//
+// Contouring gives a uniform mesh: about two triangles per cell of surface,
+// flat faces included. simplify_mesh collapses flat regions and simple creases
+// with half-edge collapses (a vertex moves onto a neighbour, so every position
+// that survives is an original contour vertex and sharp corners stay exact),
+// cheapest first by Garland-Heckbert quadric error.
+//
+// The error bound: each vertex carries the planes of the original triangles
+// (and, on material borders, planes through the border edge standing on its
+// triangles) that were merged into it, with weight 1 each: not area-weighted,
+// so that sqrt(quadric error) >= the distance to every single plane. A
+// collapse is made only when sqrt(error at the kept vertex) <= max_error: the
+// kept vertex lies within max_error of the plane of every original triangle
+// its new fan replaced. (A large triangle's interior is bounded only through
+// its corners: on curved surfaces it may lie a little further, as for any
+// vertex-quadric method; tests/test_simplify.cpp measures a sphere.)
+//
+// What it never does (each refusal counted in SimplifyStats):
+// - change topology: a vertex moves only when it is a manifold interior
+//   vertex (one disc of triangles, every edge used twice, once each way, no
+//   degenerate triangle); the collapsed edge passes the link condition (the
+//   two ends share exactly the two opposite vertices) and the kept vertex
+//   keeps at least 3 triangles. Boundary and non-manifold vertices and
+//   vertices on degenerate triangles never move, so existing defects do not
+//   grow (they may still receive a neighbour);
+// - move a material border: a vertex whose triangles have one material may
+//   collapse onto any neighbour; a vertex on a border between exactly two
+//   materials (two border edges, at least two triangles of each) only slides
+//   along the border onto one of its two border neighbours; a vertex where
+//   three materials meet, or with more border edges, never moves;
+// - flip or crush a triangle: every changed triangle keeps its normal within
+//   max_normal_change_deg, is not degenerate (exact collinearity test), and
+//   its smallest angle is not below min_angle_deg unless it was already;
+// - add a self-intersection: every changed triangle is tested with exact
+//   predicates (contour/detail/triangle_intersection.h, the rules of
+//   mesh_quality) against every triangle near it and the other changed
+//   triangles; a collapse is refused if any pair meets, unless the triangles
+//   it replaces were in more intersecting pairs (folds the input already had
+//   may be collapsed away). mesh_quality's self_intersecting_pairs never grows.
+//
+// Parallel and deterministic: space is cut into blocks (block_size); blocks
+// are simplified in parallel, each moving only vertices whose triangles lie
+// in the block; then again with blocks shifted by half a block, so that the
+// seams are simplified too; a last pass over the whole mesh in one piece
+// finishes what both block layouts left (vertices near where seams of the two
+// layouts cross, and collapses that need a fan wider than a block: a cube
+// becomes 12 triangles). Each block works in a fixed order, so the output is
+// the same for any thread count. Cost: about linear in the triangles.
+struct SimplifyOptions {
+  // The error bound, in world units (metres) [Limit: >= 0, finite]. 0 leaves
+  // the mesh untouched (uniform output). Tools take it in cells of h.
+  double max_error = 0.0;
+  // Stop once the mesh has at most this many triangles (0 = no target)
+  // [Limit: >= 0]. The bound still holds: when every collapse within
+  // max_error is made and the mesh is still above the target, it stops there
+  // (above the target). While a target is set, each parallel pass lets a block
+  // remove only its share (by triangles) of the excess, and the last pass,
+  // in one piece and cheapest first, stops at the target: the result has
+  // target or target - 1 triangles when the bound allows (a collapse removes 2).
+  size_t target_triangles = 0;
+  // Largest angle a changed triangle's normal may turn by [Limit: (0, 180)]
+  // [Units: degrees]. Below 90 refuses flips; 75 lets the triangles that
+  // bevel a right-angled crease fold onto its faces.
+  double max_normal_change_deg = 75.0;
+  // A changed triangle's smallest angle may not fall below this unless it
+  // already was [Limit: [0, 30]] [Units: degrees]. Keeps slivers out.
+  double min_angle_deg = 1.0;
+  // Edge of the blocks simplified in parallel [Limit: >= 0, finite] [Units:
+  // world]; 0 = 32 times the mean edge length of the input (32 cells on a
+  // contoured mesh). Larger blocks leave fewer seams, smaller ones balance
+  // threads better.
+  double block_size = 0.0;
+};
+
+struct SimplifyStats {
+  size_t triangles_before = 0;
+  size_t triangles_after = 0;
+  size_t vertices_before = 0;
+  size_t vertices_after = 0;           // vertices still used (unused ones are dropped)
+  size_t collapses = 0;
+  size_t locked_vertices = 0;          // boundary, non-manifold or on a degenerate triangle: never moved
+  // Collapses within the bound that were refused, by the first check that failed:
+  size_t rejected_topology = 0;        // link condition, or too few triangles left
+  size_t rejected_flip = 0;            // a normal turned too far, or a triangle degenerate
+  size_t rejected_sliver = 0;          // a triangle's smallest angle fell below min_angle_deg
+  size_t rejected_intersection = 0;    // a changed triangle would meet another
+  size_t passes = 0;                   // passes run (blocks, shifted blocks, whole mesh)
+  size_t blocks = 0;                   // blocks simplified, over all passes
+  double max_error_reached = 0.0;      // largest sqrt(quadric error) of a collapse made (world units)
+  double seconds = 0.0;
+};
+
+Status check_simplify_options(const SimplifyOptions& options);
+
+// Simplifies `mesh` in place within options.max_error (see above). Surviving
+// vertices keep their position, normal and material, and triangles their
+// material and orientation; triangles and vertices keep their relative order
+// (dead ones removed, unused vertices dropped). max_error == 0 returns at once
+// with the mesh unchanged. Errors: bad options (kInvalidArgument, naming the
+// field); cancellation through ctx (kCancelled, mesh unchanged). Stage timer
+// "simplify" on ctx.
+Result<SimplifyStats> simplify_mesh(ContourMesh& mesh, const SimplifyOptions& options, Context* ctx = nullptr);
 
 }  // namespace ldc

@@ -88,10 +88,9 @@ struct VertexSource {
 
 }  // namespace
 
-void patch_box(const glm::ivec3& node_lo, const glm::ivec3& node_hi, int relax_iterations, glm::ivec3* lo,
-               glm::ivec3* hi) {
-  *lo = node_lo - 1 - relax_iterations;
-  *hi = node_hi + relax_iterations + 1;
+void patch_box(const glm::ivec3& node_lo, const glm::ivec3& node_hi, int reach, glm::ivec3* lo, glm::ivec3* hi) {
+  *lo = node_lo - 1 - reach;
+  *hi = node_hi + reach + 1;
 }
 
 MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm::ivec3& lo, const glm::ivec3& hi,

@@ -248,6 +248,16 @@ glm::dvec3 particle_closed_form(const Qef& q, int planes, const glm::dvec3& x0, 
 
 }  // namespace
 
+int qef_rank(const Qef& q, double truncation) {
+  double m[3][3] = {{q.a00, q.a01, q.a02}, {q.a01, q.a11, q.a12}, {q.a02, q.a12, q.a22}};
+  double w[3], v[3][3];
+  symmetric_eigen(m, w, v);
+  const double largest = std::max({std::abs(w[0]), std::abs(w[1]), std::abs(w[2])});
+  int rank = 0;
+  for (double lambda : w) rank += largest > 0.0 && std::abs(lambda) > truncation * largest;
+  return rank;
+}
+
 PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::dvec3& cell_min,
                           const ContourConfig& config) {
   PlacedVertex out;

@@ -146,7 +146,7 @@ CellPlanes RegionMesher::planes_of(const glm::ivec3& cell, const CellSheets& she
 // Every vertex the box's quads use is placed; in the relaxation margin
 // beyond them only cells with a border vertex are, as relaxation reads no
 // others. A cell's sheets get consecutive vertices.
-void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi, ContourStats& stats) {
+void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi) {
   std::vector<uint8_t> marked = cells_with_vertex();
   cell_vertex_.assign(marked.size(), -1);
   cell_corners_.assign(marked.size(), 0);
@@ -169,26 +169,27 @@ void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& u
         if (!any_border && !in_box(cell, used_lo, used_hi)) continue;
         cell_vertex_[i] = int32_t(verts_.size());
         cell_corners_[i] = uint8_t(corners);
-        for (int s = 0; s < sheets.count; ++s) add_vertex(cell, s, planes[s], stats);
+        for (int s = 0; s < sheets.count; ++s) add_vertex(cell, s, planes[s]);
       }
     }
   }
 }
 
-void RegionMesher::add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes, ContourStats& stats) {
+void RegionMesher::add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes) {
   CellVertex v;
   v.cell = cell;
   v.sheet = uint8_t(sheet);
   v.qef = Qef::of(planes);
+  v.mass = planes.mass_point();
   PlacedVertex pv = place_vertex(planes, v.qef, glm::dvec3(0.0), config_);
   v.x = pv.position;
   v.material = planes.majority_material();
   v.normal = planes.mean_normal();
   v.border = planes.mixed_materials();
+  v.rank = uint8_t(pv.rank);
+  v.clamped = pv.clamped;
   if (v.border) border_.push_back(uint32_t(verts_.size()));
   verts_.push_back(v);
-  if (config_.placement == Placement::kQef) ++stats.qef_rank[pv.rank];
-  stats.clamped_vertices += pv.clamped;
 }
 
 // Elastic net on material borders: every border vertex moves towards the mean
@@ -311,7 +312,12 @@ void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
     m.positions[i] = lat.to_world(glm::dvec3(v.cell) + v.x);
     m.normals[i] = v.normal;
     m.vertex_material[i] = v.material;
-    if (i < out.own_vertices) stats.relaxed_vertices += v.border && config_.relax_iterations > 0;
+    if (i < out.own_vertices) {
+      stats.relaxed_vertices += v.border && config_.relax_iterations > 0;
+      stats.untangled_vertices += v.untangled;
+      stats.clamped_vertices += v.clamped;
+      if (config_.placement == Placement::kQef) ++stats.qef_rank[v.rank];
+    }
   }
   stats.cells += out.own_vertices;
 }
@@ -340,17 +346,21 @@ void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
   out.vertex_cell.clear();
   out.vertex_sheet.clear();
   out.own_vertices = 0;
-  // Quads need the cells one below; relaxation one more cell per iteration on
-  // every side, but only where materials meet.
-  load(own_lo, own_hi, 1, 0);
+  // Quads need the cells one below, untangling untangle_reach cells more on
+  // every side; relaxation one more cell per iteration, but only where
+  // materials meet.
+  const int untangle_margin = untangle_reach(config_);
+  load(own_lo, own_hi, 1 + untangle_margin, untangle_margin);
   if (config_.relax_iterations > 0 && !single_material()) {
-    load(own_lo, own_hi, margin(), margin() - 1);
+    const int reach = vertex_reach(config_);
+    load(own_lo, own_hi, 1 + reach, reach);
   }
   stats.multi_crossing_edges += region_.multi_crossing_edges();
   stats.thin_edges += region_.thin_edges();
   if (region_.uniform()) return;
-  place_vertices(own_lo - 1, own_hi, stats);
+  place_vertices(own_lo - 1 - untangle_margin, own_hi + untangle_margin);
   relax();
+  untangle(own_lo - 1, own_hi);
   emit(own_lo, own_hi, out, stats, order_triangles);
 }
 

@@ -125,11 +125,16 @@ TEST(RayCast, HitsLieOnTheContouredSurface) {
   for (const Case& c : {Case{"sphere", sphere(1.0, glm::dvec3(0.03, 0.01, -0.02))}, Case{"box", box},
                         Case{"cylinder", cylinder}}) {
     World world = build_primitive(c.shape, h);
-    Result<ContourMesh> mesh = contour_world(world);
+    // Placement alone (the planes' meeting points); untangling moves ~1% of
+    // the vertices, next to folds at the box's and cylinder's edges, to their
+    // mass points (checked below, looser).
+    Result<ContourMesh> mesh = contour_world(world, {.untangle = false});
+    Result<ContourMesh> untangled = contour_world(world);
+    ASSERT_TRUE(untangled.ok());
     ASSERT_TRUE(mesh.ok());
     Queries queries(world);
     std::mt19937 rng(11);
-    std::vector<double> errors;
+    std::vector<double> errors, untangled_errors;
     int agree = 0, total = 0;
     for (int i = 0; i < 1000; ++i) {
       const glm::dvec3 o = 2.5 * random_unit(rng), target = 0.9 * random_unit(rng);
@@ -139,7 +144,10 @@ TEST(RayCast, HitsLieOnTheContouredSurface) {
       if (!hit->hit) continue;
       ++agree;
       errors.push_back(distance_to_mesh(mesh.value(), hit->point, 2 * h) / h);
+      untangled_errors.push_back(distance_to_mesh(untangled.value(), hit->point, 2 * h) / h);
     }
+    std::sort(untangled_errors.begin(), untangled_errors.end());
+    EXPECT_LT(untangled_errors[untangled_errors.size() * 99 / 100], 0.35) << c.name << " (untangled)";
     std::sort(errors.begin(), errors.end());
     const double median = errors[errors.size() / 2], p99 = errors[errors.size() * 99 / 100], worst = errors.back();
     std::printf("%s: %d/%d hit, distance to contoured mesh median %.3f h, p99 %.3f h, worst %.3f h\n", c.name, agree,

@@ -92,37 +92,43 @@ void append_mesh(TriangleMesh& a, const TriangleMesh& b) {
   if (a.chunks().size() != b.chunks().size()) {
     return ::testing::AssertionFailure() << a.chunks().size() << " vs " << b.chunks().size() << " chunk meshes";
   }
-  using Key = std::array<int, 10>;
-  auto triangles = [](const ChunkMesh& m) {
+  // Vertices are named by cell and sheet (a cell crossed by several sheets has a vertex per sheet).
+  using Name = std::array<int, 4>;
+  auto name = [](const ChunkMesh& m, uint32_t v) {
+    const glm::ivec3& c = m.vertex_cell[v];
+    return Name{c.z, c.y, c.x, m.vertex_sheet[v]};
+  };
+  using Key = std::array<int, 13>;
+  auto triangles = [&](const ChunkMesh& m) {
     std::vector<Key> out;
     for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
-      glm::ivec3 c[3] = {m.vertex_cell[m.mesh.triangles[t].x], m.vertex_cell[m.mesh.triangles[t].y],
-                         m.vertex_cell[m.mesh.triangles[t].z]};
-      int first = 0;  // rotate the smallest cell first: same triangle, same key
+      const glm::uvec3& tri = m.mesh.triangles[t];
+      Name c[3] = {name(m, tri.x), name(m, tri.y), name(m, tri.z)};
+      int first = 0;  // rotate the smallest name first: same triangle, same key
       for (int j = 1; j < 3; ++j) {
-        if (std::tie(c[j].z, c[j].y, c[j].x) < std::tie(c[first].z, c[first].y, c[first].x)) first = j;
+        if (c[j] < c[first]) first = j;
       }
       Key k;
       for (int j = 0; j < 3; ++j)
-        for (int d = 0; d < 3; ++d) k[size_t(j * 3 + d)] = c[(first + j) % 3][d];
-      k[9] = m.mesh.triangle_material[t];
+        for (int d = 0; d < 4; ++d) k[size_t(j * 4 + d)] = c[(first + j) % 3][size_t(d)];
+      k[12] = m.mesh.triangle_material[t];
       out.push_back(k);
     }
     std::sort(out.begin(), out.end());
     return out;
   };
-  auto vertices = [](const ChunkMesh& m) {
-    std::map<std::array<int, 3>, std::tuple<glm::dvec3, glm::vec3, uint16_t>> out;
-    for (size_t v = 0; v < m.vertex_cell.size(); ++v) {
-      const glm::ivec3& c = m.vertex_cell[v];
-      out[{c.x, c.y, c.z}] = {m.mesh.positions[v], m.mesh.normals[v], m.mesh.vertex_material[v]};
+  auto vertices = [&](const ChunkMesh& m) {
+    std::map<Name, std::tuple<glm::dvec3, glm::vec3, uint16_t>> out;
+    for (uint32_t v = 0; v < m.vertex_cell.size(); ++v) {
+      out[name(m, v)] = {m.mesh.positions[v], m.mesh.normals[v], m.mesh.vertex_material[v]};
     }
     return out;
   };
   for (size_t i = 0; i < a.chunks().size(); ++i) {
     const ChunkMesh &x = a.chunks()[i], &y = b.chunks()[i];
     bool same_own = x.own_vertices == y.own_vertices &&
-                    std::equal(x.vertex_cell.begin(), x.vertex_cell.begin() + long(x.own_vertices), y.vertex_cell.begin());
+                    std::equal(x.vertex_cell.begin(), x.vertex_cell.begin() + long(x.own_vertices), y.vertex_cell.begin()) &&
+                    std::equal(x.vertex_sheet.begin(), x.vertex_sheet.begin() + long(x.own_vertices), y.vertex_sheet.begin());
     if (x.chunk != y.chunk || !same_own || vertices(x) != vertices(y) || triangles(x) != triangles(y)) {
       return ::testing::AssertionFailure() << "chunk mesh " << i << " differs";
     }

@@ -4,10 +4,11 @@
 //
 // Why this is exact: a cell's vertex depends only on the crossings on its 12
 // edges and, through material-border relaxation, on vertices at most
-// relax_iterations cells away; a quad depends on its edge and its four
-// vertices. So when the crossings change only on edges between nodes of a
-// box D, the vertices that can change lie in the cells B = [D.lo - 1 - R,
-// D.hi + R) and the quads that can change lie on edges whose lower node is in
+// relax_iterations cells away, and through untangling on placed vertices a
+// few cells further (R = RegionMesher::vertex_reach in all); a quad depends
+// on its edge and its four vertices. So when the crossings change only on
+// edges between nodes of a box D, the vertices that can change lie in the
+// cells B = [D.lo - 1 - R, D.hi + R) and the quads that can change lie on edges whose lower node is in
 // P = [B.lo, B.hi + 1). Everything outside P is kept as it was; P is meshed by
 // the same RegionMesher as a full build, which yields the same bits for any
 // box (tests compare against fresh builds).
@@ -35,9 +36,10 @@ struct MeshPatch {
   std::vector<Triangle> triangles;  // of every edge whose lower node is in the box
 };
 
-// The patch box for crossings changed between the nodes of [node_lo, node_hi).
-void patch_box(const glm::ivec3& node_lo, const glm::ivec3& node_hi, int relax_iterations, glm::ivec3* lo,
-               glm::ivec3* hi);
+// The patch box for crossings changed between the nodes of [node_lo, node_hi),
+// for vertices whose positions read data `reach` cells beyond their own
+// cell (RegionMesher::vertex_reach).
+void patch_box(const glm::ivec3& node_lo, const glm::ivec3& node_hi, int reach, glm::ivec3* lo, glm::ivec3* hi);
 
 // Meshes the box, in slabs along z in parallel.
 MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm::ivec3& lo, const glm::ivec3& hi,

@@ -51,6 +51,10 @@ struct PlacedVertex {
 PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::dvec3& cell_min,
                           const ContourConfig& config);
 
+// How many of the QEF's eigenvalues exceed `truncation` times the largest:
+// 1 on a flat piece, 2 on a crease, 3 at a corner.
+int qef_rank(const Qef& qef, double truncation);
+
 // Clamps x into the cell grown by `slack` on every side.
 glm::dvec3 clamp_to_cell(const glm::dvec3& x, const glm::dvec3& cell_min, double slack, bool* clamped);
 

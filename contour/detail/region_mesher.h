@@ -23,9 +23,11 @@ class RegionMesher {
   void mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out, ContourStats& stats,
             bool order_triangles = true);
 
-  // Cells of margin needed below a box (quads read the cells one below) when
-  // relaxation runs: it reaches one cell further per iteration, on every side.
-  int margin() const { return config_.relax_iterations + 1; }
+  // How many cells away from a vertex the data its final position depends
+  // on may lie, beyond its own cell's edges: relaxation reaches one cell
+  // further per iteration, untangling untangle_reach cells.
+  static int vertex_reach(const ContourConfig& config);
+  static int untangle_reach(const ContourConfig& config);
 
  private:
   struct CellVertex {
@@ -36,6 +38,10 @@ class RegionMesher {
     glm::vec3 normal{0.0f};  // mean of its crossings' normals
     uint16_t material = 0;
     bool border = false;  // its quads have different materials
+    bool untangled = false;  // moved to its mass point to clear a self-intersection
+    bool clamped = false;    // the cell (plus slack) held it back from its planes' optimum
+    uint8_t rank = 3;        // kQef: eigenvalues kept
+    glm::dvec3 mass{0.0};  // the mean of its crossings: the safe position untangling falls back to
   };
   // The vertices of a quad: a sheet in each of the four cells around an edge.
   struct Quad {
@@ -51,9 +57,13 @@ class RegionMesher {
   // The sheet of `cell` that holds the edge from `node` along `axis` (a crossing edge of the cell).
   uint8_t sheet_of(const glm::ivec3& cell, int axis, const glm::ivec3& node) const;
   CellPlanes planes_of(const glm::ivec3& cell, const CellSheets& sheets, int sheet) const;
-  void place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi, ContourStats& stats);
-  void add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes, ContourStats& stats);
+  void place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi);
+  void add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes);
   void relax();
+  // Moves the vertices near self-intersecting triangles to their mass points
+  // (see untangle.cpp); `decide_lo/hi` is the cell box whose vertices matter.
+  void untangle(const glm::ivec3& decide_lo, const glm::ivec3& decide_hi);
+  std::vector<uint8_t> tangled_cells(const glm::ivec3& test_lo, const glm::ivec3& test_hi) const;
   glm::dvec3 relaxed_position(const CellVertex& v) const;
   bool edge_quad(int axis, const glm::ivec3& node, Quad* quad) const;
   // The quads around one vertex: one per crossing edge of its sheet.
