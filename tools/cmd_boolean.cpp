@@ -138,6 +138,7 @@ int run_boolean(const BooleanArgs& a, const CommonOptions& common) {
 
 void add_boolean_command(CLI::App& app, CommonOptions& common) {
   auto args = std::make_shared<BooleanArgs>();
+  args->mesh.max_error_cells = kAdaptiveMaxErrorCells;  // adaptive by default
   CLI::App* cmd = app.add_subcommand(
       "boolean", "Union, subtraction or intersection of two meshes on one lattice -> mesh, with the quality report");
   cmd->add_option("first", args->first, "Mesh file A (.obj .ply .stl .off)")->required();

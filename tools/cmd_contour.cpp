@@ -54,6 +54,7 @@ void add_contour_commands(CLI::App& app, CommonOptions& common) {
     if (code != 0) throw CLI::RuntimeError(code);
   });
   auto r = std::make_shared<ContourArgs>();
+  r->mesh.max_error_cells = kAdaptiveMaxErrorCells;  // adaptive by default; contour stays uniform (engine-like)
   CLI::App* remesh = app.add_subcommand("remesh", "Mesh -> LDC -> mesh: a watertight remesh, with the quality report");
   remesh->add_option("input", r->input, "Mesh file (.obj .ply .stl .off)")->required();
   add_mesh_output_options(remesh, r->mesh);

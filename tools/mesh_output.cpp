@@ -1,5 +1,6 @@
 #include "mesh_output.h"
 
+#include <cmath>
 #include <cstdio>
 
 #include "meshio/meshio.h"
@@ -51,6 +52,37 @@ nlohmann::json quality_json(const MeshQuality& q, const ContourStats& s) {
           {"chunks_meshed", s.chunks_meshed}};
 }
 
+nlohmann::json simplify_json(const SimplifyStats& s, double max_error, double cells) {
+  return {{"max_error", max_error},
+          {"max_error_cells", cells},
+          {"triangles_before", s.triangles_before},
+          {"triangles_after", s.triangles_after},
+          {"collapses", s.collapses},
+          {"locked_vertices", s.locked_vertices},
+          {"rejected_topology", s.rejected_topology},
+          {"rejected_flip", s.rejected_flip},
+          {"rejected_sliver", s.rejected_sliver},
+          {"rejected_intersection", s.rejected_intersection},
+          {"max_error_reached", s.max_error_reached}};
+}
+
+// Contours (and simplifies, with --max-error > 0), timing each step.
+Result<ContourMesh> mesh_world(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats& stats,
+                               nlohmann::json& report) {
+  ScopedTimer t(nullptr, "");
+  Result<ContourMesh> mesh = run_method(w, a, ctx, &stats);
+  report["seconds"]["contour"] = t.seconds();
+  if (!mesh.ok() || a.max_error_cells == 0.0) return mesh;
+  const double max_error = a.max_error_cells * w.lattice().cell_size;
+  ScopedTimer s(nullptr, "");
+  Result<SimplifyStats> simple =
+      simplify_mesh(mesh.value(), {.max_error = max_error, .target_triangles = a.target_triangles}, ctx);
+  report["seconds"]["simplify"] = s.seconds();
+  if (!simple.ok()) return simple.status();
+  report["simplify"] = simplify_json(simple.value(), max_error, a.max_error_cells);
+  return mesh;
+}
+
 void print_report(const nlohmann::json& j) {
   const auto& q = j["quality"];
   // "closed" only for a closed 2-manifold without self-intersections; otherwise what fails.
@@ -63,6 +95,12 @@ void print_report(const nlohmann::json& j) {
               q["watertight"].get<bool>() ? "watertight" : "NOT watertight", q["boundary_edges"].get<size_t>(),
               q["nonmanifold_edges"].get<size_t>(), q["nonmanifold_vertices"].get<size_t>(),
               q["self_intersecting_pairs"].get<size_t>(), q["degenerate_triangles"].get<size_t>());
+  if (j.contains("simplify")) {
+    const auto& s = j["simplify"];
+    std::printf("  adaptive: %zu -> %zu triangles within %g cells (%g m); %zu collapses\n",
+                s["triangles_before"].get<size_t>(), s["triangles_after"].get<size_t>(),
+                s["max_error_cells"].get<double>(), s["max_error"].get<double>(), s["collapses"].get<size_t>());
+  }
   std::printf("  min angle %.1f deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
   for (const auto& b : q["min_angle_histogram_10deg"]) std::printf(" %zu", b.get<size_t>());
   std::printf("\n  area %.6g, volume %.6g\n", q["area"].get<double>(), q["volume"].get<double>());
@@ -77,6 +115,12 @@ void add_mesh_output_options(CLI::App* cmd, MeshOutputArgs& a) {
   cmd->add_option("--iterations", a.config.iterations, "Iterative placement: steps")->capture_default_str();
   cmd->add_option("--relax", a.config.relax_iterations, "Material-border relaxation steps (0 = off)")->capture_default_str();
   cmd->add_option("--slack", a.config.cell_slack, "How far vertices may leave their cell (fraction of h)")->capture_default_str();
+  cmd->add_option("--max-error", a.max_error_cells,
+                  "Adaptive output: simplify within this distance, in cells of h (0 = uniform output)")
+      ->capture_default_str();
+  cmd->add_option("--target-triangles", a.target_triangles,
+                  "Adaptive output: stop simplifying at this many triangles (0 = no target; the bound still holds)")
+      ->capture_default_str();
 }
 
 void add_grid_options(CLI::App* cmd, GridConfig& grid, const std::string& cells_of) {
@@ -87,15 +131,21 @@ void add_grid_options(CLI::App* cmd, GridConfig& grid, const std::string& cells_
 
 Status check_mesh_output(const MeshOutputArgs& args) {
   Result<MeshFormat> format = mesh_format_from_path(args.output);
-  return format.ok() ? Status{} : format.status();
+  if (!format.ok()) return format.status();
+  if (!(args.max_error_cells >= 0.0 && std::isfinite(args.max_error_cells)))
+    return Status(ErrorCode::kInvalidArgument,
+                  "--max-error " + std::to_string(args.max_error_cells) + ": must be a finite number of cells >= 0");
+  if (args.target_triangles > 0 && args.max_error_cells == 0.0)
+    return Status(ErrorCode::kInvalidArgument,
+                  "--target-triangles " + std::to_string(args.target_triangles) +
+                      " needs --max-error > 0 (with --max-error 0 the output is uniform)");
+  return {};
 }
 
 int contour_and_report(const std::string& command, const World& w, const MeshOutputArgs& a, ProgressBar& bar,
                        nlohmann::json report, const CommonOptions& common, const ExtraReportLines& extra_lines) {
-  ScopedTimer t(nullptr, "");
   ContourStats stats;
-  Result<ContourMesh> mesh = run_method(w, a, bar.context(), &stats);
-  report["seconds"]["contour"] = t.seconds();
+  Result<ContourMesh> mesh = mesh_world(w, a, bar.context(), stats, report);
   if (!mesh.ok()) return fail(command, mesh.status());
   report["method"] = a.method;
   return write_and_report(command, w, mesh.value(), stats, a.output, bar, std::move(report), common, extra_lines);
