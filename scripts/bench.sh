@@ -4,7 +4,20 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
-bash scripts/build.sh -DLDC_BUILD_BENCH=ON
+# Benchmark-only peers of bench_boolean_process, never needed to build or test
+# ldc (without them it skips their rows): native Manifold, built once from
+# ../shared/peers into a prefix outside the repository (LDC_PEERS_PREFIX,
+# default ../peers-prefix), and npm manifold-3d (bench/js, pinned by its lock).
+peers_prefix=${LDC_PEERS_PREFIX:-$(realpath -m ../peers-prefix)}
+manifold_args=()
+if [ ! -f "$peers_prefix/lib/cmake/manifold/manifoldConfig.cmake" ] && [ -f ../shared/peers/build-manifold.sh ]; then
+  bash ../shared/peers/build-manifold.sh "$peers_prefix" || echo "bench.sh: the Manifold build failed; its rows are skipped"
+fi
+if [ -f "$peers_prefix/lib/cmake/manifold/manifoldConfig.cmake" ]; then
+  manifold_args=(-Dmanifold_DIR="$peers_prefix/lib/cmake/manifold")
+fi
+(cd bench/js && npm ci --no-audit --no-fund --silent) || echo "bench.sh: npm ci in bench/js failed; manifold-3d rows are skipped"
+bash scripts/build.sh -DLDC_BUILD_BENCH=ON ${manifold_args[@]+"${manifold_args[@]}"}
 mkdir -p docs
 {
   echo "# Benchmarks"
@@ -28,6 +41,14 @@ mkdir -p docs
   echo "csg_rocker_sphere.svg, csg_spot_spot.svg (in docs/)."
   echo
   ./build/bench/bench_csg --plots docs
+  echo
+  echo "## Mesh booleans as users run them: whole processes against CGAL and Manifold (issue 19)"
+  echo
+  echo "Plots of error against time and against triangles: bool_process_<case>_time.svg and"
+  echo "bool_process_<case>_tris.svg; every row in bool_process.csv (in docs/). ldc rows: the defaults (adaptive)"
+  echo "and \`--max-error 0\` (uniform)."
+  echo
+  ./build/bench/bench_boolean_process --plots docs --ldc-args "" --ldc-args "--max-error 0"
   echo
   echo "## Game edits on the default landscape (issue 4)"
   echo
