@@ -74,23 +74,26 @@ void time_edit(ldc::WorldEditor& ed, ldc::ChunkedMesh& meshes, const GameEdit& e
 void game_table(bool quick) {
   std::printf("\n## Game edits on the default landscape (h = 0.2 m)\n\n");
   std::printf("Median of %d runs; each edit is undone (untimed) before the next run. "
-              "`edit` = WorldEditor::apply; `edit + re-mesh` adds ChunkedMesh::update on the dirty list.\n\n",
+              "`edit` = WorldEditor::apply; `edit + re-mesh` adds ChunkedMesh::update on the dirty list, "
+              "with ContourConfig::untangle off (LiveConfig's default) and on.\n\n",
               quick ? 5 : 21);
-  std::printf("| edit | C | threads | chunks changed | chunks re-meshed | edit ms | edit + re-mesh ms |\n");
-  std::printf("|---|---|---|---|---|---|---|\n");
+  std::printf("| edit | C | threads | untangle | chunks changed | chunks re-meshed | edit ms | edit + re-mesh ms |\n");
+  std::printf("|---|---|---|---|---|---|---|---|\n");
   for (int c : {16, 32}) {
     ldc::World w = ldc::build_terrain({}, 0.2, c).value();
     for (int threads : {1, 2}) {
       tbb::global_control gc(tbb::global_control::max_allowed_parallelism, size_t(threads));
-      ldc::WorldEditor ed(w);
-      ldc::ChunkedMesh meshes;
-      if (!meshes.build(ed.world()).ok()) std::abort();
-      for (const GameEdit& e : game_edits(w)) {
-        double edit_ms = 0, total_ms = 0;
-        size_t chunks = 0, remeshed = 0;
-        time_edit(ed, meshes, e, quick ? 5 : 21, &edit_ms, &total_ms, &chunks, &remeshed);
-        std::printf("| %s | %d | %d | %zu | %zu | %.2f | %.2f |\n", e.name, c, threads, chunks, remeshed, edit_ms,
-                    total_ms);
+      for (bool untangle : {false, true}) {
+        ldc::WorldEditor ed(w);
+        ldc::ChunkedMesh meshes({.untangle = untangle});
+        if (!meshes.build(ed.world()).ok()) std::abort();
+        for (const GameEdit& e : game_edits(w)) {
+          double edit_ms = 0, total_ms = 0;
+          size_t chunks = 0, remeshed = 0;
+          time_edit(ed, meshes, e, quick ? 5 : 21, &edit_ms, &total_ms, &chunks, &remeshed);
+          std::printf("| %s | %d | %d | %s | %zu | %zu | %.2f | %.2f |\n", e.name, c, threads, untangle ? "on" : "off",
+                      chunks, remeshed, edit_ms, total_ms);
+        }
       }
     }
   }
@@ -101,7 +104,7 @@ void stress_table(bool quick) {
   std::printf("\n## %d random digs on the default landscape (h = 0.2 m, C = 32, 2 threads)\n\n", n);
   ldc::World w = ldc::build_terrain({}, 0.2, 32).value();
   ldc::WorldEditor ed(w);
-  ldc::ChunkedMesh meshes;
+  ldc::ChunkedMesh meshes({.untangle = false});  // LiveConfig's default
   if (!meshes.build(ed.world()).ok()) std::abort();
   ldc::WorldStats before = ed.world().stats();
   std::mt19937 rng(1);

@@ -52,7 +52,27 @@ Box box_of(const glm::dvec3* p, const glm::uvec3& t) {
 bool clearly_apart(const glm::dvec3* p, const glm::uvec3& t, const glm::uvec3& u) {
   const glm::dvec3 n = glm::cross(p[t.y] - p[t.x], p[t.z] - p[t.x]);
   const double margin = 1e-7 * (std::abs(n.x) + std::abs(n.y) + std::abs(n.z));
-  int above = 0, below = 0, other = 0;
+  int above = 0, below = 0, other = 0, shared[2] = {0, 0}, n_shared = 0;
+  uint32_t third = 0;
+  for (int j = 0; j < 3; ++j) {
+    if (u[j] == t.x || u[j] == t.y || u[j] == t.z) {
+      if (n_shared < 2) shared[n_shared] = int(u[j]);
+      ++n_shared;
+    } else {
+      third = u[j];
+    }
+  }
+  if (n_shared == 2) {
+    // Two triangles on one edge a-b meet beyond it only when folded onto
+    // each other: their third corners on the same side of a-b. Clearly on
+    // opposite sides (the normals of a-b-c and a-b-d point apart) they do not.
+    const glm::dvec3 &a = p[shared[0]], &b = p[shared[1]];
+    uint32_t c = t.x;
+    if (c == uint32_t(shared[0]) || c == uint32_t(shared[1])) c = t.y;
+    if (c == uint32_t(shared[0]) || c == uint32_t(shared[1])) c = t.z;
+    const glm::dvec3 nc = glm::cross(b - a, p[c] - a), nd = glm::cross(b - a, p[third] - a);
+    if (glm::dot(nc, nd) < -1e-7 * glm::length(nc) * glm::length(nd)) return true;
+  }
   for (int j = 0; j < 3; ++j) {
     if (u[j] == t.x || u[j] == t.y || u[j] == t.z) continue;
     ++other;

@@ -120,7 +120,9 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   nlohmann::json report = {{"input", a.input}, {"script", a.script}, {"output", a.output},
                            {"edits", nlohmann::json::array()}, {"seconds", {{"load", load.seconds()}}}};
   ScopedTimer contour(nullptr, "");
-  Result<LiveWorld> created = LiveWorld::create(std::move(w).value(), {.meshes = !a.mesh.empty()}, bar.context());
+  // The mesh goes to a file: untangled, unlike a game's chunk meshes (LiveConfig's default).
+  Result<LiveWorld> created = LiveWorld::create(
+      std::move(w).value(), {.meshes = !a.mesh.empty(), .contour = {.untangle = true}}, bar.context());
   if (!created.ok()) return fail("edit", created.status());
   LiveWorld& live = created.value();
   if (live.meshes()) report["seconds"]["contour_before_edits"] = contour.seconds();
