@@ -3,6 +3,7 @@
 #include "contour/detail/cell_sheets.h"
 
 #include <array>
+#include <vector>
 
 namespace ldc::detail {
 namespace {
@@ -31,14 +32,23 @@ int slot_between(int a, int b) {
 // next[s] = the crossing after crossing s on its loop. Walking each face
 // counter-clockwise seen from outside the cube, a run of inside corners
 // gives one segment, from the crossing entering the run to the one leaving it.
-std::array<int, 12> trace_segments(unsigned inside) {
+// On a joined face (a bit of `joined_faces`, two diagonal inside corners) the
+// inside corners are joined instead: each segment runs from the crossing
+// entering an inside corner back round the outside corner before it.
+std::array<int, 12> trace_segments(unsigned inside, unsigned joined_faces) {
   std::array<int, 12> next;
   next.fill(-1);
   auto in = [&](int c) { return ((inside >> c) & 1) != 0; };
-  for (const auto& f : kFaces) {
+  for (int face = 0; face < 6; ++face) {
+    const int* f = kFaces[face];
+    const bool join = ((joined_faces >> face) & 1) && in(f[0]) == in(f[2]) && in(f[1]) == in(f[3]) && in(f[0]) != in(f[1]);
     for (int k = 0; k < 4; ++k) {
       int a = f[k], b = f[(k + 1) % 4];
       if (in(a) || !in(b)) continue;
+      if (join) {
+        next[slot_between(a, b)] = slot_between(f[(k + 3) % 4], a);
+        continue;
+      }
       int j = (k + 1) % 4;
       while (in(f[(j + 1) % 4])) j = (j + 1) % 4;
       next[slot_between(a, b)] = slot_between(f[j], f[(j + 1) % 4]);
@@ -47,11 +57,11 @@ std::array<int, 12> trace_segments(unsigned inside) {
   return next;
 }
 
-CellSheets make_entry(unsigned inside) {
+CellSheets make_entry(unsigned inside, unsigned joined_faces) {
   CellSheets s;
   for (int8_t& e : s.sheet_of_edge) e = -1;
   for (uint8_t& n : s.loop_size) n = 0;
-  std::array<int, 12> next = trace_segments(inside);
+  std::array<int, 12> next = trace_segments(inside, joined_faces);
   for (int start = 0; start < 12; ++start) {
     if (next[start] < 0 || s.sheet_of_edge[start] >= 0) continue;
     const int sheet = s.count++;
@@ -63,17 +73,35 @@ CellSheets make_entry(unsigned inside) {
   return s;
 }
 
-std::array<CellSheets, 256> make_table() {
-  std::array<CellSheets, 256> table;
-  for (unsigned c = 0; c < 256; ++c) table[c] = make_entry(c);
+std::vector<CellSheets> make_table() {
+  std::vector<CellSheets> table(256 * 64);
+  for (unsigned joined = 0; joined < 64; ++joined)
+    for (unsigned c = 0; c < 256; ++c) table[joined * 256 + c] = make_entry(c, joined);
   return table;
 }
 
 }  // namespace
 
-const CellSheets& cell_sheets(unsigned inside_corners) {
-  static const std::array<CellSheets, 256> table = make_table();
-  return table[inside_corners & 255u];
+const CellSheets& cell_sheets(unsigned inside_corners, unsigned joined_faces) {
+  static const std::vector<CellSheets> table = make_table();  // 16,384 entries, about 1 MB, traced in a few ms
+  return table[(joined_faces & 63u) * 256 + (inside_corners & 255u)];
+}
+
+bool face_is_ambiguous(unsigned inside_corners, int face) {
+  const int* f = kFaces[face];
+  auto in = [&](int c) { return ((inside_corners >> c) & 1) != 0; };
+  return in(f[0]) == in(f[2]) && in(f[1]) == in(f[3]) && in(f[0]) != in(f[1]);
+}
+
+bool face_links_both_segments(unsigned inside_corners, int face) {
+  if (!face_is_ambiguous(inside_corners, face)) return false;
+  const CellSheets& s = cell_sheets(inside_corners);
+  const int* f = kFaces[face];
+  const int first = s.sheet_of_edge[slot_between(f[0], f[1])];
+  for (int k = 1; k < 4; ++k) {
+    if (s.sheet_of_edge[slot_between(f[k], f[(k + 1) % 4])] != first) return false;
+  }
+  return true;
 }
 
 glm::ivec3 cell_edge_offset(int slot) {

@@ -14,9 +14,9 @@
 // rule from both cells sharing a face (contour/detail/cell_sheets.h; the
 // dual of marching cubes on that table, as in Nielson's dual marching
 // cubes). So every vertex's triangles form one disk and every edge has two
-// triangles: the output is a closed 2-manifold wherever two cells sharing a
-// face are not joined through both segments of that face (a tunnel thinner
-// than a cell).
+// triangles: the output is a closed 2-manifold. (Where both cells sharing an
+// ambiguous face would pass one sheet through both of its segments, a
+// tunnel thinner than a cell, that face joins its inside corners instead.)
 //
 // Rules this module follows (documented choices):
 // - An edge with several crossings (an odd number when its ends differ)

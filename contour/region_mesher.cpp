@@ -47,8 +47,29 @@ unsigned RegionMesher::inside_corners(const glm::ivec3& cell) const {
   return bits;
 }
 
+// The faces of the cell to join (see face_links_both_segments): those whose
+// cells on both sides would link both of the face's segments. Faces towards
+// cells outside the cell box stay apart; no vertex that matters is there.
+unsigned RegionMesher::joined_faces(const glm::ivec3& cell, unsigned corners) const {
+  unsigned joined = 0;
+  for (int face = 0; face < 6; ++face) {
+    if (!face_is_ambiguous(corners, face) || !face_links_both_segments(corners, face)) continue;
+    const int axis = face / 2, side = face % 2;
+    glm::ivec3 across = cell;
+    across[axis] += side ? 1 : -1;
+    if (!in_cell_box(across)) continue;
+    if (face_links_both_segments(inside_corners(across), 2 * axis + 1 - side)) joined |= 1u << face;
+  }
+  return joined;
+}
+
+const CellSheets& RegionMesher::sheets_of(const glm::ivec3& cell) const {
+  const uint16_t key = cell_sheet_key_[cell_index(cell)];
+  return cell_sheets(key & 255u, key >> 8);
+}
+
 uint8_t RegionMesher::sheet_of(const glm::ivec3& cell, int axis, const glm::ivec3& node) const {
-  const CellSheets& sheets = cell_sheets(cell_corners_[cell_index(cell)]);
+  const CellSheets& sheets = sheets_of(cell);
   return uint8_t(sheets.sheet_of_edge[cell_edge_slot(axis, node - cell)]);
 }
 
@@ -70,7 +91,7 @@ bool RegionMesher::edge_quad(int axis, const glm::ivec3& node, Quad* quad) const
 }
 
 int RegionMesher::vertex_quads(const CellVertex& v, Quad* quads) const {
-  const CellSheets& sheets = cell_sheets(cell_corners_[cell_index(v.cell)]);
+  const CellSheets& sheets = sheets_of(v.cell);
   int n = 0;
   for (int slot = 0; slot < 12; ++slot) {
     if (sheets.sheet_of_edge[slot] != v.sheet) continue;
@@ -149,7 +170,7 @@ CellPlanes RegionMesher::planes_of(const glm::ivec3& cell, const CellSheets& she
 void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi) {
   std::vector<uint8_t> marked = cells_with_vertex();
   cell_vertex_.assign(marked.size(), -1);
-  cell_corners_.assign(marked.size(), 0);
+  cell_sheet_key_.assign(marked.size(), 0);
   verts_.clear();
   border_.clear();
   size_t i = 0;
@@ -160,7 +181,8 @@ void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& u
         if (!marked[i]) continue;
         const glm::ivec3 cell(x, y, z);
         const unsigned corners = inside_corners(cell);
-        const CellSheets& sheets = cell_sheets(corners);
+        const unsigned joined = joined_faces(cell, corners);
+        const CellSheets& sheets = cell_sheets(corners, joined);
         bool any_border = false;
         for (int s = 0; s < sheets.count; ++s) {
           planes[s] = planes_of(cell, sheets, s);
@@ -168,7 +190,7 @@ void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& u
         }
         if (!any_border && !in_box(cell, used_lo, used_hi)) continue;
         cell_vertex_[i] = int32_t(verts_.size());
-        cell_corners_[i] = uint8_t(corners);
+        cell_sheet_key_[i] = uint16_t(corners | joined << 8);
         for (int s = 0; s < sheets.count; ++s) add_vertex(cell, s, planes[s]);
       }
     }
@@ -346,11 +368,12 @@ void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
   out.vertex_cell.clear();
   out.vertex_sheet.clear();
   out.own_vertices = 0;
-  // Quads need the cells one below, untangling untangle_reach cells more on
-  // every side; relaxation one more cell per iteration, but only where
+  // Quads need the cells one below, and a cell's sheets its face
+  // neighbours' corners: one cell more; untangling untangle_reach cells more
+  // on every side; relaxation one more cell per iteration, but only where
   // materials meet.
   const int untangle_margin = untangle_reach(config_);
-  load(own_lo, own_hi, 1 + untangle_margin, untangle_margin);
+  load(own_lo, own_hi, 2 + untangle_margin, 1 + untangle_margin);
   if (config_.relax_iterations > 0 && !single_material()) {
     const int reach = vertex_reach(config_);
     load(own_lo, own_hi, 1 + reach, reach);

@@ -97,7 +97,7 @@ int RegionMesher::untangle_reach(const ContourConfig& config) {
 }
 
 int RegionMesher::vertex_reach(const ContourConfig& config) {
-  return config.relax_iterations + untangle_reach(config);
+  return 1 + config.relax_iterations + untangle_reach(config);  // 1: sheets read the face neighbours' corners
 }
 
 // Cells (over the cell box) holding a vertex of an intersecting triangle

@@ -5,7 +5,8 @@
 // face with two crossings joins them; a face with four (two inside corners on
 // one diagonal) joins the crossings around each inside corner, so the two
 // inside corners are kept apart. The rule reads only the face's corners, so
-// both cells sharing a face pair its crossings the same way. Every crossing
+// both cells sharing a face pair its crossings the same way (one exception,
+// decided from both cells' corners: face_links_both_segments). Every crossing
 // lies on two faces of the cell, so the segments close into loops; each loop
 // bounds one disk of surface in the cell: a sheet. Dual contouring places one
 // vertex per sheet (not per cell), and the quad of a crossing edge joins, in
@@ -34,8 +35,22 @@ struct CellSheets {
   uint8_t loop[kMaxSheets][12];
 };
 
-// The table entry for a cell whose inside corners are the set bits.
-const CellSheets& cell_sheets(unsigned inside_corners);
+// The table entry for a cell whose inside corners are the set bits, with the
+// faces whose bits are set in `joined_faces` (face 2 * axis + side: x = 0,
+// x = 1, y = 0, y = 1, z = 0, z = 1) joining their two diagonal inside
+// corners instead of keeping them apart (ignored on faces that are not
+// ambiguous).
+const CellSheets& cell_sheets(unsigned inside_corners, unsigned joined_faces = 0);
+
+// Whether the face holds two diagonal inside corners and two outside ones.
+bool face_is_ambiguous(unsigned inside_corners, int face);
+
+// Whether, under the default rule, one sheet of the cell passes through both
+// segments of an ambiguous face. When the cells on both sides of a face do,
+// their two vertices would be joined by two quads' edges (a tunnel thinner
+// than a cell): that face is joined instead, from both sides, which turns the
+// tunnel into two sheets on one side or the other.
+bool face_links_both_segments(unsigned inside_corners, int face);
 
 // The lower corner's offset in the cell, and the axis, of edge slot `slot`.
 glm::ivec3 cell_edge_offset(int slot);

@@ -54,6 +54,8 @@ class RegionMesher {
   bool single_material() const;
   std::vector<uint8_t> cells_with_vertex() const;
   unsigned inside_corners(const glm::ivec3& cell) const;
+  unsigned joined_faces(const glm::ivec3& cell, unsigned corners) const;
+  const CellSheets& sheets_of(const glm::ivec3& cell) const;
   // The sheet of `cell` that holds the edge from `node` along `axis` (a crossing edge of the cell).
   uint8_t sheet_of(const glm::ivec3& cell, int axis, const glm::ivec3& node) const;
   CellPlanes planes_of(const glm::ivec3& cell, const CellSheets& sheets, int sheet) const;
@@ -83,7 +85,7 @@ class RegionMesher {
   Region region_;
   glm::ivec3 cell_lo_{0}, cell_hi_{0};
   std::vector<int32_t> cell_vertex_;   // index into verts_ of the cell's sheet 0 (its sheets follow), -1 without
-  std::vector<uint8_t> cell_corners_;  // inside corners of every cell with a vertex
+  std::vector<uint16_t> cell_sheet_key_;  // of every cell with a vertex: inside corners | joined faces << 8
   std::vector<CellVertex> verts_;
   std::vector<uint32_t> border_;  // vertices on a material border
 };
