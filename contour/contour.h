@@ -333,10 +333,13 @@ std::string quality_failures(const MeshQuality& quality);
 // - flip or crush a triangle: every changed triangle keeps its normal within
 //   max_normal_change_deg, is not degenerate (exact collinearity test), and
 //   its smallest angle is not below min_angle_deg unless it was already;
-// - add a self-intersection: every changed triangle is tested with exact
-//   predicates (contour/detail/triangle_intersection.h, the rules of
-//   mesh_quality) against every triangle near it and the other changed
-//   triangles; a collapse is refused if any pair meets, unless the triangles
+// - add a self-intersection: every changed triangle is checked against
+//   every triangle near it and the other changed triangles, by the rules of
+//   mesh_quality (contour/detail/triangle_intersection.h): pairs that
+//   floating-point tests with a margin over rounding prove apart (a
+//   separating axis; fans that are certainly stars around their vertex) are
+//   skipped, the rest go to the exact predicates; a collapse is refused if
+//   any pair meets, unless the triangles
 //   it replaces were in more intersecting pairs (folds the input already had
 //   may be collapsed away). mesh_quality's self_intersecting_pairs never grows.
 //
