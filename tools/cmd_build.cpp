@@ -117,7 +117,7 @@ int run_build(const BuildArgs& a, const CommonOptions& common) {
                         {"info", world_info_json(w.value(), a.validate)}};
   out["build"]["stages"] = stage_seconds(*bar.context());
   if (common.json) {
-    std::printf("%s\n", out.dump(2).c_str());
+    std::printf("%s\n", json_text(out).c_str());
   } else {
     std::printf("built %s in %.3f s (%zu repaired rays)\n%s", a.output.c_str(), report.seconds,
                 report.repaired_rays, world_info_text(out["info"]).c_str());

@@ -153,7 +153,7 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
                             });
   }
   report["ok"] = true;
-  if (common.json) std::printf("%s\n", report.dump(2).c_str());
+  if (common.json) std::printf("%s\n", json_text(report).c_str());
   else print_edit_report(report);
   return 0;
 }

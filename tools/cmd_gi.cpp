@@ -148,7 +148,7 @@ void print_report(const GiArgs& a, const GiLights& lights, const GiRun& r, bool 
       j["reference"] = {{"samples", a.samples}};
       j["seconds"]["reference"] = r.reference_seconds;
     }
-    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("%s\n", json_text(j).c_str());
     return;
   }
   std::printf("gi: %s, %d levels of %d^3 voxels of %.3g m, %zu surface voxels; voxelize %.3f s\n", r.device.c_str(),

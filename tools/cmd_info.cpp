@@ -21,7 +21,7 @@ int run_info(const InfoArgs& a, const CommonOptions& common) {
   if (!w.ok()) return fail("info", w.status());
   nlohmann::json info = world_info_json(w.value(), !a.no_validate);
   info["file"] = a.input;
-  if (common.json) std::printf("%s\n", info.dump(2).c_str());
+  if (common.json) std::printf("%s\n", json_text(info).c_str());
   else std::printf("file        %s\n%s", a.input.c_str(), world_info_text(info).c_str());
   if (!a.no_validate && !info["validation"]["ok"].get<bool>()) return 2;
   return 0;

@@ -62,7 +62,7 @@ int run_inside(const InsideArgs& a, const CommonOptions& common) {
     out.push_back({{"point", {p.x, p.y, p.z}}, {"inside", in}});
   }
   nlohmann::json doc = {{"points", out}, {"inside_count", count}, {"total", pts.value().size()}};
-  std::printf("%s\n", doc.dump(common.json ? 2 : -1).c_str());
+  std::printf("%s\n", json_text(doc, common.json ? 2 : -1).c_str());
   return 0;
 }
 

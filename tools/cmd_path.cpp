@@ -106,14 +106,14 @@ int run_path(PathArgs a, const CommonOptions& common) {
   if (!path.ok()) return fail("path", path.status());
   const nlohmann::json out = path_json(path.value(), nav.value(), build_seconds, query_seconds);
   if (a.output.empty()) {
-    std::printf("%s\n", out.dump(2).c_str());
+    std::printf("%s\n", json_text(out).c_str());
     if (!common.json) print_summary(stderr, out);
     return 0;
   }
-  if (Status s = write_file_atomically(a.output, out.dump(2) + "\n"); !s.ok()) return fail("path", s);
+  if (Status s = write_file_atomically(a.output, json_text(out) + "\n"); !s.ok()) return fail("path", s);
   if (common.json) {
-    std::printf("%s\n", nlohmann::json{{"ok", true}, {"output", a.output}, {"status", out["status"]},
-                                       {"length", out["length"]}}.dump(2).c_str());
+    std::printf("%s\n", json_text(nlohmann::json{{"ok", true}, {"output", a.output}, {"status", out["status"]},
+                                                 {"length", out["length"]}}).c_str());
   } else {
     print_summary(stdout, out);
     std::printf("wrote %s\n", a.output.c_str());

@@ -215,7 +215,7 @@ void write_vec3(std::FILE* f, double x, double y, double z) { std::fprintf(f, "[
 // The hits, one ray a line (streamed: a camera's worth of rays would make a
 // big JSON tree).
 bool write_hits(std::FILE* f, const nlohmann::json& summary, const RaySource& src, const std::vector<RayHit>& hits) {
-  std::fprintf(f, "{\"summary\": %s,\n\"rays\": [", summary.dump().c_str());
+  std::fprintf(f, "{\"summary\": %s,\n\"rays\": [", json_text(summary, -1).c_str());
   for (size_t i = 0; i < hits.size(); ++i) {
     const RayHit& h = hits[i];
     std::fprintf(f, "%s\n{", i ? "," : "");
@@ -304,7 +304,7 @@ int run_raycast(const RaycastArgs& a, const CommonOptions& common) {
   if (!ok) return fail("raycast", "-o " + a.output + ": write failed");
   if (common.json) {
     nlohmann::json report = {{"ok", true}, {"output", a.output}, {"summary", summary}};
-    std::printf("%s\n", report.dump(2).c_str());
+    std::printf("%s\n", json_text(report).c_str());
   } else {
     print_summary(stdout, summary, hits);
     std::printf("wrote %s\n", a.output.c_str());

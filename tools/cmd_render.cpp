@@ -179,7 +179,7 @@ int run_render(const RenderArgs& a, const CommonOptions& common) {
 
   const nlohmann::json report = report_json(a, img.value(), c, stats, seconds);
   if (common.json) {
-    std::printf("%s\n", report.dump(2).c_str());
+    std::printf("%s\n", json_text(report).c_str());
     return 0;
   }
   print_report(a, c, stats, report);

@@ -39,7 +39,7 @@ int run_terrain(TerrainArgs a, const CommonOptions& common) {
   if (!s.ok()) return fail("terrain", s);
   nlohmann::json info = world_info_json(w.value(), a.validate);
   if (common.json) {
-    std::printf("%s\n", nlohmann::json({{"output", a.output}, {"seconds", report.seconds}, {"info", info}}).dump(2).c_str());
+    std::printf("%s\n", json_text({{"output", a.output}, {"seconds", report.seconds}, {"info", info}}).c_str());
   } else {
     std::printf("landscape (seed %u, %.0f x %.0f m, h = %g m) built in %.3f s -> %s\n%s", a.config.seed,
                 a.config.size_x, a.config.size_y, a.cell_size, report.seconds, a.output.c_str(),

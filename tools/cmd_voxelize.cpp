@@ -151,7 +151,7 @@ int run_voxelize(const VoxelizeArgs& a, const CommonOptions& common) {
   j.value()["threads"] = thread_count();
   j.value()["ray_axis"] = axis_name(axis.value());
   if (common.json) {
-    std::printf("%s\n", j.value().dump(2).c_str());
+    std::printf("%s\n", json_text(j.value()).c_str());
   } else {
     print_text(j.value());
   }

@@ -201,4 +201,8 @@ std::string axis_name(int axis) { return std::string(1, char('x' + axis)); }
 
 nlohmann::json vec_json(const glm::dvec3& v) { return {v.x, v.y, v.z}; }
 
+std::string json_text(const nlohmann::json& j, int indent) {
+  return j.dump(indent, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 }  // namespace ldc::tool

@@ -68,6 +68,11 @@ std::string axis_name(int axis);
 // [x, y, z] for JSON output.
 nlohmann::json vec_json(const glm::dvec3& v);
 
+// The JSON text of a report (indent as nlohmann's dump; -1 = one line).
+// Strings that are not valid UTF-8 (file names, metadata read from a file)
+// have their bad bytes replaced by U+FFFD instead of aborting the tool.
+std::string json_text(const nlohmann::json& j, int indent = 2);
+
 // "1,2.5,3" -> finite numbers; false when malformed.
 bool parse_numbers(const std::string& text, std::vector<double>* out);
 // "1,2,3" -> vector; false when malformed.

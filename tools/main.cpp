@@ -1,5 +1,7 @@
 // The ldc command-line tool: one subcommand per capability.
 #include <cstdio>
+#include <exception>
+#include <new>
 
 #include "common.h"
 #include "ldc/io.h"
@@ -32,6 +34,12 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const std::bad_alloc&) {
+    std::fprintf(stderr, "ldc: out of memory\n");
+    return 1;
+  } catch (const std::exception& e) {  // never an abort: name what went wrong
+    std::fprintf(stderr, "ldc: internal error: %s\n", e.what());
+    return 1;
   }
   return 0;
 }

@@ -165,7 +165,7 @@ int write_and_report(const std::string& command, const World& w, const ContourMe
   report["quality"] = quality_json(mesh_quality(mesh), stats);
   report["seconds"]["quality"] = q.seconds();  // the report's own cost (self-intersection test included)
   if (common.json) {
-    std::printf("%s\n", report.dump(2).c_str());
+    std::printf("%s\n", json_text(report).c_str());
     return 0;
   }
   print_report(report);
