@@ -37,6 +37,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "contour/contour.h"
+#include "contour/detail/grid_cell.h"
 #include "contour/detail/triangle_intersection.h"
 
 namespace ldc {
@@ -211,14 +212,7 @@ struct Grid {
   double size = 1.0;
   glm::ivec3 dims{1};
 
-  glm::ivec3 cell(const glm::dvec3& p) const {
-    glm::ivec3 c;
-    for (int k = 0; k < 3; ++k) {
-      const double x = std::floor((p[k] - origin[k]) / size);
-      c[k] = x <= 0.0 ? 0 : x >= dims[k] - 1 ? dims[k] - 1 : static_cast<int>(x);
-    }
-    return c;
-  }
+  glm::ivec3 cell(const glm::dvec3& p) const { return detail::clamped_grid_cell(p, origin, size, dims); }
   uint64_t key(const glm::ivec3& c) const {
     return (uint64_t(c.z) * uint64_t(dims.y) + uint64_t(c.y)) * uint64_t(dims.x) + uint64_t(c.x);
   }

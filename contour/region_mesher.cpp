@@ -53,7 +53,7 @@ unsigned RegionMesher::inside_corners(const glm::ivec3& cell) const {
 unsigned RegionMesher::joined_faces(const glm::ivec3& cell, unsigned corners) const {
   unsigned joined = 0;
   for (int face = 0; face < 6; ++face) {
-    if (!face_is_ambiguous(corners, face) || !face_links_both_segments(corners, face)) continue;
+    if (!face_links_both_segments(corners, face)) continue;  // false on faces that are not ambiguous
     const int axis = face / 2, side = face % 2;
     glm::ivec3 across = cell;
     across[axis] += side ? 1 : -1;

@@ -43,6 +43,7 @@
 #include <tbb/parallel_for.h>
 
 #include "contour/contour.h"
+#include "contour/detail/grid_cell.h"
 #include "contour/detail/triangle_intersection.h"
 
 namespace ldc {
@@ -239,14 +240,7 @@ struct Layout {
   glm::ivec3 dims{1};
 
   // Monotone in each coordinate (clamped into the grid).
-  glm::ivec3 coords(const glm::dvec3& p) const {
-    glm::ivec3 c;
-    for (int k = 0; k < 3; ++k) {
-      const double x = std::floor((p[k] - origin[k]) / size);
-      c[k] = x <= 0.0 ? 0 : x >= dims[k] - 1 ? dims[k] - 1 : static_cast<int>(x);
-    }
-    return c;
-  }
+  glm::ivec3 coords(const glm::dvec3& p) const { return detail::clamped_grid_cell(p, origin, size, dims); }
   uint32_t index(const glm::ivec3& c) const { return static_cast<uint32_t>((c.z * dims.y + c.y) * dims.x + c.x); }
   size_t count() const { return size_t(dims.x) * size_t(dims.y) * size_t(dims.z); }
   glm::ivec3 coords_of(uint32_t i) const { return {int(i % dims.x), int(i / dims.x % dims.y), int(i / dims.x / dims.y)}; }
@@ -389,14 +383,7 @@ class TriangleGrid {
 
  private:
   static constexpr size_t kLargeCells = 64;
-  glm::ivec3 cell(const glm::dvec3& p) const {
-    glm::ivec3 c;
-    for (int k = 0; k < 3; ++k) {
-      const double x = std::floor((p[k] - origin_[k]) / size_);
-      c[k] = x <= 0.0 ? 0 : x >= dims_[k] - 1 ? dims_[k] - 1 : static_cast<int>(x);
-    }
-    return c;
-  }
+  glm::ivec3 cell(const glm::dvec3& p) const { return detail::clamped_grid_cell(p, origin_, size_, dims_); }
   static size_t cell_count(const glm::ivec3& lo, const glm::ivec3& hi) {
     return size_t(hi.x - lo.x + 1) * size_t(hi.y - lo.y + 1) * size_t(hi.z - lo.z + 1);
   }
