@@ -59,6 +59,10 @@ struct BuildReport {
   size_t dropped_crossings = 0;      // crossings removed by the repair
   size_t normal_flips = 0;           // normals turned to point out of the solid
   size_t nudged_points = 0;          // points moved off a lattice node by one depth step
+  // How the mesh's connected components were read (BuildConfig::mode).
+  size_t solid_components = 0;       // read as solids (winding number)
+  size_t surface_components = 0;     // read as thin shells under their triangles
+  size_t shell_triangles = 0;        // input triangles that became shells
 };
 
 // --- Triangle meshes ---------------------------------------------------------
@@ -79,6 +83,45 @@ struct BuildReport {
 // in BuildReport::repaired_rays.
 Result<World> build_from_mesh(const TriangleMesh& mesh, const GridConfig& grid,
                               Context* ctx = nullptr, BuildReport* report = nullptr);
+
+// How a mesh's triangles become a solid.
+//
+// Game levels are rarely closed: floors are one-sided planes, rooms are open
+// on a side, walls are single quads, props float. No winding number (and no
+// vote) can say what such a sheet encloses, because it encloses nothing. The
+// surface reading gives every such triangle a thin closed shell instead: a
+// prism whose top face is the triangle itself (exact crossings and normals)
+// and which reaches `shell_thickness` below it, on the side away from up
+// (for a wall: behind its front face). Prisms are closed, so their union is
+// read by the exact winding rule and needs no repair. This is what Recast's
+// rasterization of each triangle into the spans of its cells does, kept
+// exact.
+enum class BuildMode : uint8_t {
+  kSolid,    // the whole mesh as one solid, repaired by votes where it is open (as build_from_mesh above)
+  kSurface,  // every triangle a shell
+  kAuto,     // per connected component: closed, outward-facing and thicker
+             // than half a shell -> solid; anything else (open, inside-out,
+             // double-sided, flat) -> shells
+};
+const char* build_mode_name(BuildMode mode);
+
+struct BuildConfig {
+  BuildMode mode = BuildMode::kSolid;
+  // How far a shell reaches below its triangle. 0: a little over one cell
+  // (h * 65/64), so that every lattice column under a wall or across a sheet
+  // sees it, as Recast's conservative rasterization does.
+  // [Units: m] [Limit: 0, or h/16 .. 16 h]
+  double shell_thickness = 0.0;
+  // Lattice axis pointing up: shells hang below floors and ceilings, so a
+  // floor's top stays exact whichever way its triangle is wound. [Limit: 0, 1, 2]
+  int up_axis = 2;
+};
+
+// The mesh read as `config` says; BuildConfig{} gives build_from_mesh above.
+// The report counts the components read each way.
+Result<World> build_from_mesh(const TriangleMesh& mesh, const GridConfig& grid,
+                              const BuildConfig& config, Context* ctx = nullptr,
+                              BuildReport* report = nullptr);
 
 // --- Implicit solids ----------------------------------------------------------
 //

@@ -18,11 +18,11 @@
 #include "ldc/build.h"
 #include "ldc/internal/build_common.h"
 #include "ldc/detail/mesh_raster.h"
+#include "ldc/detail/mesh_shells.h"
 #include "ldc/internal/ray_math.h"
 
 namespace ldc {
 namespace detail {
-namespace {
 
 // ---------------------------------------------------------------------------
 // Stage 1: snap and weld
@@ -59,6 +59,8 @@ Status snap_vertices(const TriangleMesh& mesh, const Lattice& lat, SnappedMesh& 
   }
   return {};
 }
+
+namespace {
 
 // Edge balance on welded triangles: a mesh is closed when every undirected edge
 // is used as often in one direction as in the other (then the winding number
@@ -125,15 +127,60 @@ Status snap_mesh(const TriangleMesh& mesh, const Lattice& lat, SnappedMesh& out,
 }
 
 }  // namespace
-}  // namespace detail
 
-Result<World> build_from_mesh(const TriangleMesh& mesh, const GridConfig& grid, Context* ctx,
-                              BuildReport* report_out) {
-  using namespace detail;
-  ScopedTimer total(ctx, "build");
-  Status s = check_mesh(mesh, "mesh");
+namespace {
+
+// The shell thickness for cell size h, or an error naming the field.
+Result<double> shell_thickness(const BuildConfig& config, double h) {
+  const double t = config.shell_thickness;
+  if (!std::isfinite(t) || t < 0.0) {
+    return Status(ErrorCode::kInvalidArgument, "shell_thickness " + std::to_string(t) +
+                                                   ": must be 0 (one cell) or a finite length > 0");
+  }
+  if (t == 0.0) return h * 65.0 / 64.0;
+  if (t < h / 16.0 || t > 16.0 * h) {
+    return Status(ErrorCode::kInvalidArgument,
+                  "shell_thickness " + std::to_string(t) + " m: must lie between h/16 and 16 h (h = " +
+                      std::to_string(h) + " m)");
+  }
+  return t;
+}
+
+Status check_build_config(const BuildConfig& config) {
+  if (config.mode != BuildMode::kSolid && config.mode != BuildMode::kSurface &&
+      config.mode != BuildMode::kAuto) {
+    return {ErrorCode::kInvalidArgument, "mode: not one of solid, surface, auto"};
+  }
+  if (config.up_axis < 0 || config.up_axis > 2) {
+    return {ErrorCode::kInvalidArgument,
+            "up_axis " + std::to_string(config.up_axis) + ": must be 0, 1 or 2"};
+  }
+  return {};
+}
+
+// The mesh as the rasterizer reads it: the input, or (surface and auto
+// modes) its sheets turned into shells. Welds on the lattice's fixed-point
+// grid first, so components join where the build's vertices do.
+Result<TriangleMesh> mesh_to_rasterize(const TriangleMesh& mesh, const Lattice& lat,
+                                       const BuildConfig& config, double thickness,
+                                       BuildReport& report) {
+  SnappedMesh welded;
+  std::vector<uint32_t> welded_id;
+  Status s = snap_vertices(mesh, lat, welded, welded_id);
   if (!s.ok()) return s;
-  if (mesh.triangles.empty()) return Status(ErrorCode::kInvalidArgument, "mesh: no triangles");
+  const MeshComponents components = mesh_components(mesh, welded_id, welded.vertices.size());
+  report.input_closed =
+      std::all_of(components.closed.begin(), components.closed.end(), [](uint8_t c) { return c != 0; });
+  report.boundary_edges = components.boundary_edges;
+  report.degenerate_triangles =
+      size_t(std::count(components.of_triangle.begin(), components.of_triangle.end(), MeshComponents::kNone));
+  return shelled_mesh(mesh, components, config.mode, thickness, config.up_axis, report);
+}
+
+// Plans the lattice; shells reach below the input, so surface readings grow
+// the box by the shell thickness (at the cell size the input alone gives).
+Result<WorldConfig> plan_mesh_grid(const TriangleMesh& mesh, const GridConfig& grid,
+                                   const BuildConfig& config, double* thickness) {
   MeshBounds mb = mesh_bounds(mesh);
   double area = 0.0;
   for (const auto& t : mesh.triangles) {
@@ -141,22 +188,77 @@ Result<World> build_from_mesh(const TriangleMesh& mesh, const GridConfig& grid, 
                                          mesh.positions[t[2]] - mesh.positions[t[0]]));
   }
   Result<WorldConfig> plan = plan_grid({mb.min, mb.max}, grid, area, "mesh");
+  if (!plan.ok() || config.mode == BuildMode::kSolid) return plan;
+  const double h = plan.value().lattice.cell_size;
+  Result<double> t = shell_thickness(config, h);
+  if (!t.ok()) return t.status();
+  *thickness = t.value();
+  GridConfig fixed = grid;
+  fixed.cell_size = h;
+  // Prisms double the surface at most (top and bottom; sides are thin).
+  return plan_grid({mb.min - glm::dvec3(*thickness), mb.max + glm::dvec3(*thickness)}, fixed,
+                   2.0 * area, "mesh");
+}
+
+}  // namespace
+}  // namespace detail
+
+const char* build_mode_name(BuildMode mode) {
+  switch (mode) {
+    case BuildMode::kSolid: return "solid";
+    case BuildMode::kSurface: return "surface";
+    case BuildMode::kAuto: return "auto";
+  }
+  return "unknown";
+}
+
+Result<World> build_from_mesh(const TriangleMesh& mesh, const GridConfig& grid, Context* ctx,
+                              BuildReport* report_out) {
+  return build_from_mesh(mesh, grid, BuildConfig{}, ctx, report_out);
+}
+
+Result<World> build_from_mesh(const TriangleMesh& mesh, const GridConfig& grid,
+                              const BuildConfig& config, Context* ctx, BuildReport* report_out) {
+  using namespace detail;
+  ScopedTimer total(ctx, "build");
+  Status s = check_mesh(mesh, "mesh");
+  if (!s.ok()) return s;
+  if (mesh.triangles.empty()) return Status(ErrorCode::kInvalidArgument, "mesh: no triangles");
+  s = check_build_config(config);
+  if (!s.ok()) return s;
+  double thickness = 0.0;
+  Result<WorldConfig> plan = plan_mesh_grid(mesh, grid, config, &thickness);
   if (!plan.ok()) return plan.status();
   try {
     World world = World::create(plan.value()).value();
     BuildReport report;
     report.triangles = mesh.triangles.size();
     SnappedMesh snapped;
+    BuildReport input;  // surface readings: the input's closedness, for the report
     {
       ScopedTimer t(ctx, "build.snap");
-      s = snap_mesh(mesh, world.lattice(), snapped, report);
+      if (config.mode == BuildMode::kSolid) {
+        s = snap_mesh(mesh, world.lattice(), snapped, report);
+      } else {
+        Result<TriangleMesh> read = mesh_to_rasterize(mesh, world.lattice(), config, thickness, report);
+        if (!read.ok()) return read.status();
+        input = report;
+        // The rasterizer repairs by votes only what the shells left open.
+        s = snap_mesh(read.value(), world.lattice(), snapped, report);
+        report.degenerate_triangles += input.degenerate_triangles;
+      }
       if (!s.ok()) return s;
     }
     s = rasterize_mesh_into(snapped, world, ctx, report);
     if (!s.ok()) return s;
+    if (config.mode != BuildMode::kSolid) {
+      report.input_closed = input.input_closed;
+      report.boundary_edges = input.boundary_edges;
+    }
     report.seconds = total.seconds();
     record_build_report(world, report);
     world.set_metadata("source", "mesh");
+    if (config.mode != BuildMode::kSolid) world.set_metadata("build.mode", build_mode_name(config.mode));
     if (report_out) *report_out = report;
     return world;
   } catch (const std::bad_alloc&) {

@@ -20,6 +20,8 @@ struct BuildArgs {
   bool terrain = false;
   std::string output;
   GridConfig grid;
+  MeshReadingArgs reading;  // mesh input
+  std::string up = "auto";  // the floor side of shells
   // primitive
   double radius = 1.0, half_height = 1.0;
   std::string half_extents = "1,1,1", translate = "0,0,0", scale = "1,1,1", axis = "0,0,1";
@@ -62,9 +64,13 @@ Result<World> build_world(const BuildArgs& a, Context* ctx, BuildReport* report)
                   "give exactly one input: a mesh file, --primitive, --heightfield or --terrain");
   }
   if (!a.input.empty()) {
+    Result<int> up = parse_up_axis(a.up, 1);  // meshes: the Recast convention, y up
+    if (!up.ok()) return up.status();
+    Result<BuildConfig> config = mesh_build_config(a.reading, up.value());
+    if (!config.ok()) return config.status();
     Result<TriangleMesh> mesh = load_mesh(a.input);
     if (!mesh.ok()) return mesh.status();
-    Result<World> w = build_from_mesh(mesh.value(), a.grid, ctx, report);
+    Result<World> w = build_from_mesh(mesh.value(), a.grid, config.value(), ctx, report);
     if (w.ok()) w.value().set_metadata("source.file", a.input);
     return w;
   }
@@ -101,7 +107,10 @@ nlohmann::json report_json(const BuildReport& r) {
           {"synthesized_points", r.synthesized_points},
           {"dropped_crossings", r.dropped_crossings},
           {"normal_flips", r.normal_flips},
-          {"nudged_points", r.nudged_points}};
+          {"nudged_points", r.nudged_points},
+          {"solid_components", r.solid_components},
+          {"surface_components", r.surface_components},
+          {"shell_triangles", r.shell_triangles}};
 }
 
 int run_build(const BuildArgs& a, const CommonOptions& common) {
@@ -119,8 +128,13 @@ int run_build(const BuildArgs& a, const CommonOptions& common) {
   if (common.json) {
     std::printf("%s\n", json_text(out).c_str());
   } else {
-    std::printf("built %s in %.3f s (%zu repaired rays)\n%s", a.output.c_str(), report.seconds,
-                report.repaired_rays, world_info_text(out["info"]).c_str());
+    std::printf("built %s in %.3f s (%zu repaired rays)\n", a.output.c_str(), report.seconds,
+                report.repaired_rays);
+    if (report.surface_components) {
+      std::printf("read %zu components as solids and %zu as shells (%zu triangles)\n",
+                  report.solid_components, report.surface_components, report.shell_triangles);
+    }
+    std::printf("%s", world_info_text(out["info"]).c_str());
   }
   if (a.validate && !out["info"]["validation"]["ok"].get<bool>()) return 2;
   return 0;
@@ -137,6 +151,8 @@ void add_build_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--cell-size", args->grid.cell_size, "Cell size h (m); overrides --cells");
   cmd->add_option("--chunk-size,--chunk", args->grid.chunk_size, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
   cmd->add_option("--padding", args->grid.padding, "Empty cells around the input")->capture_default_str();
+  add_mesh_reading_options(cmd, args->reading, "solid");
+  add_up_option(cmd, args->up, "y for a mesh (the Recast convention); sets which side of a shell is its floor");
   cmd->add_option("--primitive", args->primitive, "sphere | box | capsule | cylinder");
   cmd->add_option("--radius", args->radius, "Primitive radius (m)")->capture_default_str();
   cmd->add_option("--half-height", args->half_height, "Capsule/cylinder half height (m)")->capture_default_str();

@@ -13,7 +13,9 @@ namespace {
 const char* const kPathHelp = R"(The input is an .ldc world, or a mesh level (OBJ, PLY, STL, OFF) that is first
 built into an LDC at the navigation cell size (--cell-size). The up axis (--up) defaults to z
 for .ldc worlds (the built-in landscape is z up; a world records no up axis) and to y for
-meshes (the Recast convention).
+meshes (the Recast convention). A mesh level is read with --mode auto: closed, outward-facing
+parts (props, boxes) as solids, and everything else (one-sided floors, single-quad walls, open
+rooms) as thin shells below their triangles, so an export from a game needs no preparation.
 Output (stdout, or -o FILE), drawable with `ldc render --overlay FILE`:
   {"status": "complete" | "unreachable" | "out_of_nodes", "length": metres,
    "path": [[x,y,z], ...], "start": [x,y,z] (the start snapped to its floor), "end": [x,y,z]
@@ -33,6 +35,7 @@ struct PathArgs {
   std::string output;
   std::string up = "auto";
   double cell_size = 0.3;
+  MeshReadingArgs reading;
   int max_nodes = 2048;  // NavQuery's default budget (nav/nav.h)
   NavConfig agent;
 };
@@ -43,11 +46,13 @@ Result<World> load_input(const PathArgs& a, Context* ctx) {
     return Status(ErrorCode::kInvalidArgument,
                   "--cell-size " + std::to_string(a.cell_size) + ": must be a finite number > 0");
   }
+  Result<BuildConfig> config = mesh_build_config(a.reading, a.agent.up_axis);
+  if (!config.ok()) return config.status();
   Result<TriangleMesh> mesh = load_mesh(a.input);
   if (!mesh.ok()) return mesh.status();
   GridConfig grid;
   grid.cell_size = a.cell_size;
-  return build_from_mesh(mesh.value(), grid, ctx);
+  return build_from_mesh(mesh.value(), grid, config.value(), ctx);
 }
 
 nlohmann::json path_json(const NavPath& path, const NavMesh& nav, double build_seconds,
@@ -131,6 +136,7 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--to", args->to, "Goal x,y,z (m)")->required();
   add_up_option(cmd, args->up, "z for an .ldc world (it records no up axis), y for a mesh");
   cmd->add_option("--cell-size", args->cell_size, "Navigation cell for mesh input (m)")->capture_default_str();
+  add_mesh_reading_options(cmd, args->reading, "auto");
   cmd->add_option("--agent-height", args->agent.agent_height, "Free height the agent needs (m)")->capture_default_str();
   cmd->add_option("--agent-radius", args->agent.agent_radius, "Agent radius: erosion from walls and drops (m)")->capture_default_str();
   cmd->add_option("--max-climb", args->agent.max_climb, "Highest step between neighbouring floors (m)")->capture_default_str();

@@ -197,6 +197,28 @@ Result<int> parse_up_axis(const std::string& text, int auto_axis) {
   return Status(ErrorCode::kInvalidArgument, "--up '" + text + "': use x, y, z or auto");
 }
 
+void add_mesh_reading_options(CLI::App* cmd, MeshReadingArgs& args, const std::string& default_mode) {
+  args.mode = default_mode;
+  cmd->add_option("--mode", args.mode,
+                  "How a mesh becomes a solid: solid (winding number, open parts repaired by votes), "
+                  "surface (every triangle a thin shell below it: one-sided floors, single-quad walls), "
+                  "auto (per connected component: closed outward-facing parts solid, the rest shells)")
+      ->capture_default_str();
+  cmd->add_option("--shell-thickness", args.shell_thickness,
+                  "How far a shell reaches below its triangle (m); 0: a little over one cell");
+}
+
+Result<BuildConfig> mesh_build_config(const MeshReadingArgs& args, int up_axis) {
+  BuildConfig config;
+  if (args.mode == "solid") config.mode = BuildMode::kSolid;
+  else if (args.mode == "surface") config.mode = BuildMode::kSurface;
+  else if (args.mode == "auto") config.mode = BuildMode::kAuto;
+  else return Status(ErrorCode::kInvalidArgument, "--mode '" + args.mode + "': use solid, surface or auto");
+  config.shell_thickness = args.shell_thickness;
+  config.up_axis = up_axis;
+  return config;
+}
+
 std::string axis_name(int axis) { return std::string(1, char('x' + axis)); }
 
 nlohmann::json vec_json(const glm::dvec3& v) { return {v.x, v.y, v.z}; }

@@ -62,6 +62,16 @@ inline constexpr int kLdcUpAxis = 2;
 void add_up_option(CLI::App* cmd, std::string& up, const std::string& auto_means);
 // "x" 0, "y" 1, "z" 2, "auto" `auto_axis`; anything else is refused, naming it.
 Result<int> parse_up_axis(const std::string& text, int auto_axis);
+// --mode and --shell-thickness of build and path: how a mesh's triangles
+// become a solid (BuildConfig in ldc/build.h). `mode` is the option's text.
+struct MeshReadingArgs {
+  std::string mode;
+  double shell_thickness = 0.0;
+};
+void add_mesh_reading_options(CLI::App* cmd, MeshReadingArgs& args, const std::string& default_mode);
+// The BuildConfig those options give, with the up axis; refuses an unknown mode, naming it.
+Result<BuildConfig> mesh_build_config(const MeshReadingArgs& args, int up_axis);
+
 // "x", "y" or "z" for an axis 0, 1 or 2 (JSON output).
 std::string axis_name(int axis);
 

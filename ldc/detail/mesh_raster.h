@@ -34,6 +34,12 @@ struct SnappedMesh {
                     uint16_t mat);
 };
 
+// Stage 1 of build_from_mesh: vertices to the lattice's fixed point, welded
+// where equal; welded_id maps input vertices to welded ones. Fills
+// `vertices` and `unsnapped` of `out`.
+Status snap_vertices(const TriangleMesh& mesh, const Lattice& lat, SnappedMesh& out,
+                     std::vector<uint32_t>& welded_id);
+
 // (B - A) x (C - A), exact.
 std::array<i128, 3> triangle_normal(const std::vector<Vec3i>& v, const std::array<uint32_t, 3>& t);
 
