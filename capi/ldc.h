@@ -281,7 +281,13 @@ typedef struct ldc_nav_config {
   double max_slope_degrees; /* [0 .. 89] [default 45] */
   int32_t max_nodes;        /* A* node budget [16 .. 1 << 20] [default 2048] */
   double search_half_extents[3]; /* how far from start/goal a floor is looked for [m] [default 2, 2, 4] */
+  uint32_t filters;         /* Recast's span filters, LDC_NAV_FILTER_* bits [default: all three] */
 } ldc_nav_config;
+
+/* NavConfig's filter_* fields (nav/nav.h). */
+#define LDC_NAV_FILTER_LOW_HANGING 1u /* steep floors just above walkable ones are walkable */
+#define LDC_NAV_FILTER_LEDGES 2u      /* floors beside a drop deeper than max_climb are not */
+#define LDC_NAV_FILTER_LOW_HEIGHT 4u  /* floors under less than agent_height are not */
 
 LDC_C_API void ldc_nav_config_default(ldc_nav_config* config);
 /* Sets the agent; the navigation data is rebuilt at the next path query. */

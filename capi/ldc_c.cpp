@@ -466,6 +466,9 @@ void ldc_nav_config_default(ldc_nav_config* config) {
   config->max_slope_degrees = d.max_slope_degrees;
   config->max_nodes = 2048;
   put(ldc::PathQueryOptions{}.search_half_extents, config->search_half_extents);
+  config->filters = (d.filter_low_hanging_obstacles ? LDC_NAV_FILTER_LOW_HANGING : 0u) |
+                    (d.filter_ledge_spans ? LDC_NAV_FILTER_LEDGES : 0u) |
+                    (d.filter_low_height_spans ? LDC_NAV_FILTER_LOW_HEIGHT : 0u);
 }
 
 ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* config) {
@@ -478,6 +481,13 @@ ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* conf
     c.agent_radius = config->agent_radius;
     c.max_climb = config->max_climb;
     c.max_slope_degrees = config->max_slope_degrees;
+    c.filter_low_hanging_obstacles = (config->filters & LDC_NAV_FILTER_LOW_HANGING) != 0;
+    c.filter_ledge_spans = (config->filters & LDC_NAV_FILTER_LEDGES) != 0;
+    c.filter_low_height_spans = (config->filters & LDC_NAV_FILTER_LOW_HEIGHT) != 0;
+    if (config->filters & ~(LDC_NAV_FILTER_LOW_HANGING | LDC_NAV_FILTER_LEDGES | LDC_NAV_FILTER_LOW_HEIGHT)) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_set_nav_config: filters has unknown bits " +
+                                            std::to_string(config->filters));
+    }
     if (ldc_status s = from_status(ldc::check_nav_config(c, world->world())); s != LDC_OK) return s;
     if (config->max_nodes < 16 || config->max_nodes > (1 << 20)) {
       return fail(LDC_INVALID_ARGUMENT, "ldc_world_set_nav_config: max_nodes " +

@@ -64,6 +64,18 @@ struct NavConfig {
   double agent_radius = 0.6;        // erosion from walls and drops [Units: m] [Limit: 0 .. chunk width / 2]
   double max_climb = 0.9;           // highest step between neighbouring floors [Units: m] [Limit: >= 0]
   double max_slope_degrees = 45.0;  // steepest walkable floor [Units: degrees] [Limit: 0 .. 89]
+  // Recast's span filters (rcFilter*), each on by default as in RecastDemo:
+  // A floor too steep to walk, at most max_climb above a walkable floor in
+  // the same column (a kerb or a stair nosing), is walkable.
+  bool filter_low_hanging_obstacles = true;
+  // A floor with a drop deeper than max_climb on one of its four sides (a
+  // ledge; the world's edge counts) is not walkable, even when agent_radius
+  // is 0 (with a radius, erosion removes it anyway).
+  bool filter_ledge_spans = true;
+  // A floor with less than agent_height free above it is not walkable. Off:
+  // such floors (and the links between them) are kept, e.g. for an agent
+  // that may crouch, and only the slope and climb rules apply.
+  bool filter_low_height_spans = true;
 };
 
 // An error naming the bad field, or ok.

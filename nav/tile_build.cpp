@@ -92,6 +92,23 @@ std::vector<const Chunk*> tile_stack(const NavData& data, const World& world,
   return stack;
 }
 
+// Recast's rcFilterLowHangingWalkableObstacles on one column (floors from
+// `start`, bottom to top): a steep floor at most max_climb above a floor that
+// was walkable by its own normal becomes walkable.
+void lift_low_hanging(const NavData& data, std::vector<NavFloor>& floors, size_t start) {
+  bool below_walkable = false;
+  float below_height = 0.0f;
+  for (size_t k = start; k < floors.size(); ++k) {
+    NavFloor& f = floors[k];
+    const bool own_walkable = !f.steep_normal;
+    if (f.steep_normal && below_walkable && f.height - below_height <= data.climb_cells) {
+      f.steep_normal = false;
+    }
+    below_walkable = own_walkable;
+    below_height = f.height;
+  }
+}
+
 }  // namespace
 
 void extract_tile(const NavData& data, const World& world, NavTile& tile) {
@@ -135,7 +152,9 @@ void extract_tile(const NavData& data, const World& world, NavTile& tile) {
         open_floor = true;
       }
     }
+    if (data.config.filter_low_hanging_obstacles) lift_low_hanging(data, tile.floors, column_start);
     // Drop floors without room for the agent.
+    if (!data.config.filter_low_height_spans) continue;
     auto first = tile.floors.begin() + std::ptrdiff_t(column_start);
     tile.floors.erase(std::remove_if(first, tile.floors.end(),
                                      [&](const NavFloor& f) {
@@ -159,7 +178,7 @@ uint8_t best_link(const NavData& data, const NavFloor& f, std::span<const NavFlo
     const float step = std::fabs(g.height - f.height);
     if (step > data.climb_cells) continue;
     const float gap = std::min(f.ceiling, g.ceiling) - std::max(f.height, g.height);
-    if (gap < data.height_cells) continue;
+    if (gap < data.height_cells && data.config.filter_low_height_spans) continue;
     if (best == kNoLink || step < best_step) {
       best = uint8_t(j);
       best_step = step;
@@ -178,6 +197,27 @@ bool slope_walkable(const NavFloor& f, const std::array<const NavFloor*, 4>& sid
   if (!f.steep_normal) return true;
   for (const NavFloor* g : side) {
     if (g && !g->steep_normal) return true;
+  }
+  return false;
+}
+
+// Recast's rcFilterLedgeSpans: a side with no linked floor is a ledge when
+// the neighbour column's floors all lie more than max_climb below f, or the
+// column is beyond the world's edge. A side blocked by a higher floor is
+// not. A column inside the world with no floor at all (solid up to a
+// ceiling, or a hole with nothing below) reads as a wall: only erosion by
+// agent_radius closes such a hole's rim.
+bool has_ledge(const NavData& data, const NavFloor& f, const glm::ivec2& col) {
+  for (int d = 0; d < 4; ++d) {
+    if (f.link[d] != kNoLink) continue;
+    const glm::ivec2 side = col + kDirStep[d];
+    if (!data.contains_tile(data.tile_of_column(side))) return true;
+    const std::span<const NavFloor> floors = data.column(side);
+    if (floors.empty()) continue;
+    const bool drop = std::all_of(floors.begin(), floors.end(), [&](const NavFloor& g) {
+      return g.height < f.height - data.climb_cells;
+    });
+    if (drop) return true;
   }
   return false;
 }
@@ -204,7 +244,8 @@ void link_tile(const NavData& data, NavTile& tile) {
           f.link[d] = mutual ? j : kNoLink;
           if (mutual) side[size_t(d)] = &col[j];
         }
-        f.walkable = slope_walkable(f, side);
+        f.walkable = slope_walkable(f, side) &&
+                     !(data.config.filter_ledge_spans && has_ledge(data, f, base + glm::ivec2(lu, lv)));
       }
     }
   }

@@ -244,6 +244,61 @@ TEST(Nav, LowCeilingBlocksAndHighCeilingPasses) {
   }
 }
 
+TEST(Nav, LowHeightFilterOffLetsTheAgentUnderALowCeiling) {
+  const World world = boxes_world({floor_slab(0, 0, 20, 4), {{8.05, 0.05, 2.5}, {12.05, 3.95, 3.0}}});
+  NavConfig crouch;
+  crouch.filter_low_height_spans = false;
+  EXPECT_EQ(path_of(nav_of(world), {2, 2, 1}, {18, 2, 1}).status, PathStatus::kUnreachable);
+  EXPECT_EQ(path_of(nav_of(world, crouch), {2, 2, 1}, {18, 2, 1}).status, PathStatus::kComplete);
+}
+
+// A platform 1.5 m above the ground (more than max_climb): with no agent
+// radius, only the ledge filter takes its rim columns out, as Recast's
+// rcFilterLedgeSpans does; the ground's outer rim has no drop (nothing lies
+// beyond it) and stays.
+TEST(Nav, LedgeFilterRemovesThePlatformRim) {
+  const World world = boxes_world({floor_slab(0, 0, 10, 10, 0.5), {{3.05, 3.05, 0.5}, {6.95, 6.95, 2.0}}});
+  NavConfig no_radius;
+  no_radius.agent_radius = 0.0;
+  NavConfig no_filter = no_radius;
+  no_filter.filter_ledge_spans = false;
+  const size_t with = nav_of(world, no_radius).stats().walkable;
+  const size_t without = nav_of(world, no_filter).stats().walkable;
+  // The platform covers columns 16 .. 34 (x and y = 3.2 .. 6.8 m): 19 x 19, rim 4 * 18.
+  EXPECT_EQ(without - with, size_t(4 * 18));
+}
+
+// A wedge whose top is steeper than max_slope, at most max_climb above the
+// ground it stands on and linked to no flat floor: walkable only through
+// Recast's low-hanging-obstacle rule.
+TEST(Nav, LowHangingFilterLiftsASteepFloorJustAboveAWalkableOne) {
+  TriangleMesh mesh = test::box_mesh({0.05, 0.05, 0.2}, {9.95, 9.95, 0.5});  // ground, top 0.5
+  // Wedge along y in [2, 8]: x from 3.0 to 3.8, top rising 60 degrees from z = 0.6.
+  const double rise = 0.8 * std::tan(60.0 * M_PI / 180.0);
+  TriangleMesh wedge;
+  wedge.positions = {{3.0, 2, 0.6}, {3.8, 2, 0.6}, {3.8, 2, 0.6 + rise},
+                     {3.0, 8, 0.6}, {3.8, 8, 0.6}, {3.8, 8, 0.6 + rise}};
+  wedge.triangles = {{0, 2, 1}, {3, 4, 5}, {0, 1, 4}, {0, 4, 3}, {1, 2, 5}, {1, 5, 4}, {0, 3, 5}, {0, 5, 2}};
+  test::append_mesh(mesh, wedge);
+  GridConfig grid;
+  grid.cell_size = kH;
+  grid.use_origin = true;
+  const World world = build_from_mesh(mesh, grid).value();
+  ASSERT_GT(world.volume(2), 10 * 10 * 0.3) << "the wedge is solid (outward winding)";
+  NavConfig config;
+  config.agent_radius = 0.0;
+  config.filter_ledge_spans = false;
+  NavConfig no_lift = config;
+  no_lift.filter_low_hanging_obstacles = false;
+  const size_t with = nav_of(world, config).stats().walkable;
+  const size_t without = nav_of(world, no_lift).stats().walkable;
+  // The wedge's columns x = 3.2 and 3.4 (0.45 and 0.79 m above the ground)
+  // are lifted; x = 3.6 (1.14 m up) then walks by its lifted neighbour's
+  // normal (slope_walkable); on the rows y = 2.2 .. 7.8.
+  EXPECT_GT(with, without);
+  EXPECT_LE(with - without, size_t(3 * 29));
+}
+
 // A bridge at z = 4 over a lower floor: two levels in the same columns.
 TEST(Nav, TwoLevelsWithABridge) {
   const World world = boxes_world({

@@ -141,6 +141,12 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--agent-radius", args->agent.agent_radius, "Agent radius: erosion from walls and drops (m)")->capture_default_str();
   cmd->add_option("--max-climb", args->agent.max_climb, "Highest step between neighbouring floors (m)")->capture_default_str();
   cmd->add_option("--max-slope", args->agent.max_slope_degrees, "Steepest walkable floor (degrees)")->capture_default_str();
+  cmd->add_flag("!--no-filter-low-hanging", args->agent.filter_low_hanging_obstacles,
+                "Do not lift steep floors just above walkable ones (Recast's low-hanging-obstacle filter)");
+  cmd->add_flag("!--no-filter-ledges", args->agent.filter_ledge_spans,
+                "Keep floors beside drops deeper than --max-climb (Recast's ledge filter)");
+  cmd->add_flag("!--no-filter-low-height", args->agent.filter_low_height_spans,
+                "Keep floors with less than --agent-height above them (Recast's low-height filter)");
   cmd->add_option("--max-nodes", args->max_nodes, "A* node budget in regions, clamped to 16 .. 1048576 (default: NavQuery's, as in nav/nav.h)")
       ->capture_default_str();
   cmd->add_option("-o,--output", args->output, "Write the path JSON here instead of stdout");

@@ -373,6 +373,11 @@ static void paths_cross_the_landscape(ldc_world* w) {
   free(corners);
   const double sky[3] = {8.0, 8.0, 90.0};
   CHECK_STATUS(ldc_world_find_path(w, sky, to, NULL, 0, &info), LDC_NOT_FOUND);
+  CHECK(nav.filters == (LDC_NAV_FILTER_LOW_HANGING | LDC_NAV_FILTER_LEDGES | LDC_NAV_FILTER_LOW_HEIGHT));
+  nav.filters = 8u;
+  CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "filters") != NULL);
+  nav.filters = LDC_NAV_FILTER_LEDGES;
   nav.max_slope_degrees = 95.0;
   CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_INVALID_ARGUMENT);
   CHECK(strstr(ldc_last_error(), "max_slope") != NULL);
