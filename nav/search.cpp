@@ -95,6 +95,19 @@ uint32_t dense_region(const NavData& data, const detail::FloorHit& hit) {
 
 // ---- NavQuery --------------------------------------------------------------
 
+namespace {
+
+// "no walkable floor within ..." and, when the mesh has none at all, why.
+Status no_floor(const NavMesh& mesh, const std::string& what) {
+  const NavStats s = mesh.stats();
+  if (s.walkable > 0) return {ErrorCode::kInvalidArgument, what};
+  return {ErrorCode::kInvalidArgument,
+          what + ": the level has no walkable floor for this agent at all (" + std::to_string(s.floors) +
+              " floors with room above; none left by max_slope, max_climb, the filters and agent_radius)"};
+}
+
+}  // namespace
+
 NavQuery::NavQuery(const NavMesh& mesh, int max_nodes)
     : mesh_(mesh),
       max_nodes_(std::clamp(max_nodes, 16, 1 << 20)),
@@ -108,9 +121,8 @@ Result<NavPoint> NavQuery::nearest_walkable(const glm::dvec3& p, const glm::dvec
   const NavData& data = *mesh_.data_;
   const auto hit = detail::nearest_floor(data, data.to_nav(p), to_nav_extent(data, half));
   if (!hit) {
-    return Status(ErrorCode::kInvalidArgument, "no walkable floor within " +
-                                                   detail::vec_text(half) + " m of " +
-                                                   detail::vec_text(p));
+    return no_floor(mesh_, "no walkable floor within " + detail::vec_text(half) + " m of " +
+                               detail::vec_text(p));
   }
   NavPoint out;
   out.position = data.to_world(hit->point);
@@ -128,9 +140,8 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
   const glm::dvec3 reach = to_nav_extent(data, options.search_half_extents);
   const auto start = detail::nearest_floor(data, data.to_nav(from), reach);
   if (!start) {
-    return Status(ErrorCode::kInvalidArgument,
-                  "no walkable floor within " + detail::vec_text(options.search_half_extents) +
-                      " m of the path start " + detail::vec_text(from));
+    return no_floor(mesh_, "no walkable floor within " + detail::vec_text(options.search_half_extents) +
+                               " m of the path start " + detail::vec_text(from));
   }
   s.reset(data.dense_count);
   s.start = start->point;
@@ -209,9 +220,8 @@ Result<NavPath> NavQuery::find_grid_path(const glm::dvec3& from, const glm::dvec
   const auto start = detail::nearest_floor(data, data.to_nav(from), reach);
   const auto goal = detail::nearest_floor(data, data.to_nav(to), reach);
   if (!start || !goal) {
-    return Status(ErrorCode::kInvalidArgument,
-                  std::string("no walkable floor within the search extents of the path ") +
-                      (start ? "goal " + detail::vec_text(to) : "start " + detail::vec_text(from)));
+    return no_floor(mesh_, std::string("no walkable floor within the search extents of the path ") +
+                               (start ? "goal " + detail::vec_text(to) : "start " + detail::vec_text(from)));
   }
   NavPath path = detail::grid_search(data, *start, *goal, max_nodes_, search_->grid);
   for (glm::dvec3& p : path.corners) p = data.to_world(p);

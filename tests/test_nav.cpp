@@ -299,6 +299,25 @@ TEST(Nav, LowHangingFilterLiftsASteepFloorJustAboveAWalkableOne) {
   EXPECT_LE(with - without, size_t(3 * 29));
 }
 
+TEST(Nav, ALevelWithNoWalkableFloorSaysSo) {
+  // A thin wall alone: its top is eroded away by the agent radius.
+  const World world = boxes_world({{{1.05, 1.05, 0.05}, {1.45, 5.95, 3.0}}});
+  const NavMesh nav = nav_of(world);
+  EXPECT_EQ(nav.stats().walkable, 0u);
+  NavQuery query(nav);
+  const Result<NavPath> path = query.find_path({1.2, 2, 3}, {1.2, 5, 3});
+  ASSERT_FALSE(path.ok());
+  EXPECT_NE(path.status().message().find("the level has no walkable floor for this agent at all"),
+            std::string::npos) << path.status().message();
+  // With floors elsewhere the message stays about the point asked for.
+  const World with_floor = boxes_world({{{1.05, 1.05, 0.05}, {1.45, 5.95, 3.0}}, floor_slab(10, 0, 16, 6)});
+  const NavMesh nav2 = nav_of(with_floor);
+  NavQuery query2(nav2);
+  const Result<NavPath> far = query2.find_path({1.2, 2, 3}, {12, 3, 1});
+  ASSERT_FALSE(far.ok());
+  EXPECT_EQ(far.status().message().find("at all"), std::string::npos) << far.status().message();
+}
+
 // A bridge at z = 4 over a lower floor: two levels in the same columns.
 TEST(Nav, TwoLevelsWithABridge) {
   const World world = boxes_world({

@@ -22,7 +22,9 @@ Output (stdout, or -o FILE), drawable with `ldc render --overlay FILE`:
    (the goal's floor, or where a partial path stops), "points": [start, end],
    "regions", "nodes_searched",
    "nav": {"floors", "walkable", "regions", "components", "memory_bytes", "build_seconds"},
-   "query_seconds"}
+   "query_seconds", "start_inside_solid", "goal_inside_solid"}
+A start or goal inside solid geometry (a wall, or deeper than --max-climb in the ground) is snapped to the nearest walkable floor
+like any other point, with a warning on stderr and *_inside_solid true in the JSON.
 "unreachable": the goal lies on another walkable island (or has no floor near it); the path
 ends at the start island's point nearest the goal. "out_of_nodes": the search spent --max-nodes
 (default 2048, the library's budget) before reaching the goal; the path ends at the explored region
@@ -84,6 +86,24 @@ void print_summary(std::FILE* f, const nlohmann::json& j) {
                j["nav"]["components"].get<size_t>(), j["nav"]["build_seconds"].get<double>() * 1e3);
 }
 
+// A point asked for inside a wall or deep in the ground is snapped to the
+// nearest floor like any other; say so, since the caller probably meant
+// something else. A point on a floor, or less than a step (max_climb) below
+// its top, is not inside.
+void warn_if_inside_solid(const World& world, const NavConfig& agent, const char* which,
+                          const glm::dvec3& asked, const glm::dvec3& used, nlohmann::json& out,
+                          bool quiet) {
+  glm::dvec3 step_up = asked;
+  step_up[agent.up_axis] += agent.max_climb;
+  const bool inside = world.inside(asked) && world.inside(step_up);
+  out[std::string(which) + "_inside_solid"] = inside;
+  if (!inside || quiet) return;
+  std::fprintf(stderr, "ldc path: warning: the %s (%g, %g, %g) lies inside solid geometry; the path %s at the "
+               "nearest walkable floor, (%g, %g, %g), %.2f m away\n", which, asked.x, asked.y, asked.z,
+               std::string(which) == "start" ? "starts" : "ends", used.x, used.y, used.z,
+               glm::length(used - asked));
+}
+
 int run_path(PathArgs a, const CommonOptions& common) {
   set_thread_count(common.threads);
   glm::dvec3 from, to;
@@ -109,7 +129,9 @@ int run_path(PathArgs a, const CommonOptions& common) {
   Result<NavPath> path = query.find_path(from, to, options);
   const double query_seconds = query_timer.seconds();
   if (!path.ok()) return fail("path", path.status());
-  const nlohmann::json out = path_json(path.value(), nav.value(), build_seconds, query_seconds);
+  nlohmann::json out = path_json(path.value(), nav.value(), build_seconds, query_seconds);
+  warn_if_inside_solid(world.value(), a.agent, "start", from, path.value().corners.front(), out, common.quiet);
+  warn_if_inside_solid(world.value(), a.agent, "goal", to, path.value().corners.back(), out, common.quiet);
   if (a.output.empty()) {
     std::printf("%s\n", json_text(out).c_str());
     if (!common.json) print_summary(stderr, out);
