@@ -2,6 +2,11 @@
 // pairs (issue 6). Prints markdown tables: build time, query time (median and
 // p99), agreement on which pairs are reachable, path length ratio, rebuild
 // after a 2 m dig, and the grid A* baseline the region search replaces.
+// Scenes: RecastDemo's nav_test.obj, the landscape, the soup levels of
+// tests/data/levels (issue 20: one-sided floors, single-quad walls, read with
+// BuildConfig kAuto) and any --level FILE.obj (y up) given.
+//
+//   bench_nav [--quick] [--data DIR] [--level FILE.obj ...]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +22,7 @@
 #include "detour_peer.h"
 #include "ldc/build.h"
 #include "ldc/terrain.h"
+#include "meshio/meshio.h"
 #include "nav/nav.h"
 
 namespace {
@@ -130,6 +136,28 @@ Scene nav_test_scene(const ldc::bench::Args& args) {
   return s;
 }
 
+// A game level from an OBJ (y up) read as a soup: closed outward-facing parts
+// as solids, everything else (one-sided floors, single-quad walls) as thin
+// shells under the triangles (BuildConfig kAuto, issue 20).
+Scene soup_scene(const std::string& name, const ldc::TriangleMesh& mesh, const std::string& source) {
+  Scene s;
+  s.name = name;
+  s.frame.up = 1;
+  s.triangles = detour_triangles(mesh.positions, mesh.triangles, s.frame);
+  ldc::GridConfig grid;
+  grid.cell_size = 0.3;  // Recast's cell size
+  ldc::BuildConfig build;
+  build.mode = ldc::BuildMode::kAuto;
+  build.up_axis = 1;
+  ldc::BuildReport report;
+  s.world_build_ms = ldc::bench::median_ms(3, [&] {
+    s.world = ldc::build_from_mesh(mesh, grid, build, nullptr, &report).value();
+  });
+  s.world_source = "build_from_mesh (" + source + ", kAuto: " + std::to_string(report.solid_components) +
+                   " solid, " + std::to_string(report.surface_components) + " surface components) at h = 0.3";
+  return s;
+}
+
 Scene landscape_scene() {
   Scene s;
   s.name = "landscape";
@@ -175,11 +203,12 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
   options.search_half_extents = glm::dvec3(2.0);
   options.search_half_extents[scene.frame.up] = 4.0;  // Detour's (2, 4, 2)
   QueryStats ours, theirs, grid;
-  int agree = 0, no_floor = 0;
+  int agree = 0, no_floor = 0, start_floor = 0;
   std::vector<double> ratios;
   std::vector<double> ours_both, theirs_both;  // query times on pairs both complete
   for (const ldc::bench::DetourPair& pair : pairs) {
     const glm::dvec3 a = scene.frame.from_detour(pair.start), b = scene.frame.from_detour(pair.goal);
+    start_floor += query.nearest_walkable(a, options.search_half_extents).ok();
     ldc::bench::DetourPath dp;
     std::vector<double> t;
     for (int r = 0; r < reps; ++r) {
@@ -298,12 +327,38 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
                   std::to_string(nstats.components) + " islands, " + fmt("%.1f", nstats.bytes_per_floor()) +
                   " bytes per floor (" + fmt("%.2f", nstats.memory_bytes / 1048576.0) + " MiB); " +
                   std::to_string(no_floor) + " pairs without an ldc floor within Detour's search box");
+  notes.push_back(scene.name + ": **ldc finds a walkable floor within (2, 4, 2) m of " +
+                  fmt("%.1f%%", 100.0 * start_floor / n) + " of Detour's " + std::to_string(pairs.size()) +
+                  " start points**");
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  const ldc::bench::Args args = ldc::bench::parse_args(argc, argv, {"nav_test.obj"});
+  // --level FILE.obj (repeatable): that level (y up) as one more soup scene.
+  std::vector<std::string> levels;
+  std::vector<char*> rest{argv[0]};
+  for (int i = 1; i < argc; ++i) {
+    if (std::string(argv[i]) == "--level") {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "usage: %s [--quick] [--data DIR] [--level FILE.obj ...]\n", argv[0]);
+        return 2;
+      }
+      levels.push_back(argv[++i]);
+    } else {
+      rest.push_back(argv[i]);
+    }
+  }
+  const ldc::bench::Args args = ldc::bench::parse_args(int(rest.size()), rest.data(), {"nav_test.obj"});
+  std::vector<ldc::TriangleMesh> level_meshes;  // read first: a bad file stops before the long runs
+  for (const std::string& path : levels) {
+    ldc::Result<ldc::TriangleMesh> mesh = ldc::load_mesh(path);
+    if (!mesh.ok()) {
+      std::fprintf(stderr, "%s\n", mesh.status().to_string().c_str());
+      return 1;
+    }
+    level_meshes.push_back(std::move(mesh.value()));
+  }
   ldc::bench::print_machine();
   std::vector<Row> rows;
   std::vector<std::string> notes;
@@ -311,6 +366,17 @@ int main(int argc, char** argv) {
   run_scene(nav_test, args.quick, rows, notes);
   Scene landscape = landscape_scene();
   run_scene(landscape, args.quick, rows, notes);
+  // The soup levels of tests/data/levels (tests/levels/make_levels.cpp), then --level files.
+  for (const char* level : {"soup_rooms", "soup_storeys", "soup_yard"}) {
+    const std::string file = std::string("levels/") + level + ".obj";
+    Scene scene = soup_scene(level, ldc::bench::load(args, file), file);
+    run_scene(scene, args.quick, rows, notes);
+  }
+  for (size_t i = 0; i < levels.size(); ++i) {
+    const std::string& path = levels[i];
+    Scene scene = soup_scene(path.substr(path.find_last_of('/') + 1), level_meshes[i], path);
+    run_scene(scene, args.quick, rows, notes);
+  }
   std::printf("\n");
   print_rows(rows);
   std::printf("\n");

@@ -1,12 +1,15 @@
 # cmake -DPROGRAM=exe -DARGS="arg1|arg2|..." -DEXIT=<code>|nonzero
 #       [-DSTDOUT_MATCH=regex] [-DSTDERR_MATCH=regex] [-DSTDERR_NO_MATCH=regex]
-#       [-DOUTPUT_FILE=path] -P check_command.cmake
+#       [-DOUTPUT_FILE=path] [-DNO_OUTPUT_FILE=path|path...] -P check_command.cmake
 # Runs PROGRAM with ARGS ('|' separates them: arguments may hold commas and
 # semicolons would split them in add_test) and passes when the exit status is
 # EXIT (a number, or "nonzero": any exit status > 0, not a crash), stdout and
 # stderr match their regexes (separately, so that a message is known to be on
-# the right stream), stderr does not match STDERR_NO_MATCH, and OUTPUT_FILE
-# (removed before the run) exists after it.
+# the right stream), stderr does not match STDERR_NO_MATCH, OUTPUT_FILE
+# (removed before the run) exists after it and none of NO_OUTPUT_FILE (removed
+# before the run too: a refused command must not write its output) does.
+# CMake regexes have no multi-line mode: ^ and $ are the ends of the whole
+# stream, so a line is anchored with (^|\n) ... (\n|$).
 if(NOT DEFINED PROGRAM OR NOT DEFINED EXIT)
   message(FATAL_ERROR "check_command.cmake: give -DPROGRAM=... and -DEXIT=...")
 endif()
@@ -14,6 +17,10 @@ string(REPLACE "|" ";" args "${ARGS}")
 if(DEFINED OUTPUT_FILE)
   file(REMOVE "${OUTPUT_FILE}")
 endif()
+string(REPLACE "|" ";" no_output_files "${NO_OUTPUT_FILE}")
+foreach(f IN LISTS no_output_files)
+  file(REMOVE "${f}")
+endforeach()
 execute_process(COMMAND "${PROGRAM}" ${args} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message(STATUS "exit status: ${code}\n--- stdout:\n${out}--- stderr:\n${err}---")
 set(failures "")
@@ -36,6 +43,11 @@ endif()
 if(DEFINED OUTPUT_FILE AND NOT EXISTS "${OUTPUT_FILE}")
   string(APPEND failures "${OUTPUT_FILE} was not written\n")
 endif()
+foreach(f IN LISTS no_output_files)
+  if(EXISTS "${f}")
+    string(APPEND failures "${f} was written, which it must not be\n")
+  endif()
+endforeach()
 if(failures)
   message(FATAL_ERROR "${failures}")
 endif()

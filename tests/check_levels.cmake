@@ -1,0 +1,32 @@
+# Runs the soup level generator (tests/levels/make_levels.cpp) into OUT_DIR and
+# compares each file byte for byte with the committed one in EXPECTED_DIR.
+#   cmake -DGENERATOR=make_levels -DOUT_DIR=dir -DEXPECTED_DIR=tests/data/levels -P check_levels.cmake
+foreach(var GENERATOR OUT_DIR EXPECTED_DIR)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "check_levels.cmake: -D${var}=... is required")
+  endif()
+endforeach()
+file(REMOVE_RECURSE ${OUT_DIR})
+file(MAKE_DIRECTORY ${OUT_DIR})
+execute_process(COMMAND ${GENERATOR} ${OUT_DIR} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "${GENERATOR} ${OUT_DIR} failed (${rc}):\n${out}${err}")
+endif()
+set(failed "")
+foreach(level soup_rooms.obj soup_storeys.obj soup_yard.obj)
+  if(NOT EXISTS ${EXPECTED_DIR}/${level})
+    list(APPEND failed "${level} (not in ${EXPECTED_DIR})")
+    continue()
+  endif()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT_DIR}/${level} ${EXPECTED_DIR}/${level}
+                  RESULT_VARIABLE differs)
+  if(NOT differs EQUAL 0)
+    list(APPEND failed ${level})
+  endif()
+endforeach()
+if(failed)
+  list(JOIN failed ", " failed)
+  message(FATAL_ERROR "the generator no longer writes the committed levels: ${failed}. If the change is meant, "
+                      "regenerate them: make_levels ${EXPECTED_DIR}")
+endif()
+message(STATUS "the generator writes the committed levels byte for byte")
