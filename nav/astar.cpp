@@ -123,6 +123,41 @@ void NavSearch::push_start(uint32_t region, const glm::dvec3& at, double to_targ
   best_distance = to_target;
 }
 
+namespace {
+
+const NavRegion& portal_target(const NavData& data, const NavPortal& p) {
+  return data.tiles[p.to_tile].regions[p.to_region];
+}
+
+}  // namespace
+
+void NavSearch::relax(const NavData& data, uint32_t n, uint32_t m, const glm::vec3& at, float g,
+                      uint32_t via, int max_nodes) {
+  float h = glm::length(glm::vec3(target) - at);
+  if (m == target_region) {  // the last stretch, at the goal region's cost
+    g += h * float(filter.cost(dense_to_region(data, m).area));
+    h = 0.0f;
+  }
+  if (!nodes.seen(m)) {
+    if (nodes.used >= max_nodes) {
+      out_of_nodes = true;
+      return;
+    }
+    nodes.touch(m);
+  } else if (g >= nodes.cost[m]) {
+    return;
+  }
+  nodes.cost[m] = g;
+  nodes.parent[m] = n;
+  nodes.via[m] = via;
+  nodes.position[m] = at;
+  nodes.push(m, g + heuristic_scale * h);
+  if (h < best_distance) {
+    best = m;
+    best_distance = h;
+  }
+}
+
 bool NavSearch::expand_one(const NavData& data, int max_nodes) {
   uint32_t n = 0;
   if (!nodes.pop(&n)) {
@@ -138,38 +173,27 @@ bool NavSearch::expand_one(const NavData& data, int max_nodes) {
   const NavRegion& r = dense_to_region(data, n, &slot);
   const NavTile& tile = data.tiles[slot];
   const glm::vec3 from = nodes.position[n];
-  const glm::vec3 goal(target);
+  const float own_cost = float(filter.cost(r.area));  // walking inside r
   for (uint32_t k = 0; k < r.portal_count; ++k) {
     const NavPortal& p = tile.portals[r.first_portal + k];
     const uint32_t m = p.to_dense;
     if (nodes.seen(m) && nodes.closed[m]) continue;
-    const glm::vec3 at = crossing_point(p, from, goal);
-    float g = nodes.cost[n] + glm::length(at - from);
-    float h = glm::length(goal - at);
-    if (m == target_region) {
-      g += h;
-      h = 0.0f;
-    }
-    if (!nodes.seen(m)) {
-      if (nodes.used >= max_nodes) {
-        out_of_nodes = true;
-        continue;
-      }
-      nodes.touch(m);
-    } else if (g >= nodes.cost[m]) {
-      continue;
-    }
-    nodes.cost[m] = g;
-    nodes.parent[m] = n;
-    nodes.via[m] = r.first_portal + k;
-    nodes.position[m] = at;
-    // Detour's H_SCALE: a hair under 1 keeps the heuristic admissible despite
-    // the float rounding of the costs.
-    nodes.push(m, g + 0.999f * h);
-    if (h < best_distance) {
-      best = m;
-      best_distance = h;
-    }
+    if (!filter.passes(portal_target(data, p).area)) continue;
+    const glm::vec3 at = crossing_point(p, from, glm::vec3(target));
+    relax(data, n, m, at, nodes.cost[n] + own_cost * glm::length(at - from), r.first_portal + k, max_nodes);
+  }
+  // Off-mesh links leaving r: walk to the link's start, then take it.
+  auto exits = std::equal_range(data.link_exits.begin(), data.link_exits.end(), LinkExit{n, 0, false});
+  for (auto e = exits.first; e != exits.second; ++e) {
+    const NavLinkSlot& link = data.links[e->slot];
+    const uint32_t m = e->reversed ? link.region_a : link.region_b;
+    if (nodes.seen(m) && nodes.closed[m]) continue;
+    if (!filter.passes_flags(link.link.flags) || !filter.passes(dense_to_region(data, m).area)) continue;
+    const glm::vec3 start(e->reversed ? link.b : link.a), end(e->reversed ? link.a : link.b);
+    const float jump = link.link.cost < 0.0 ? glm::length(end - start)
+                                            : float(link.link.cost / data.lattice.cell_size);
+    const float g = nodes.cost[n] + own_cost * glm::length(start - from) + jump;
+    relax(data, n, m, end, g, kViaLink | uint32_t(e - data.link_exits.begin()), max_nodes);
   }
   return true;
 }
@@ -186,12 +210,30 @@ NavPath NavSearch::make_path(const NavData& data) const {
   std::vector<uint32_t> chain;
   for (uint32_t n = end_node; n != UINT32_MAX; n = nodes.parent[n]) chain.push_back(n);
   std::reverse(chain.begin(), chain.end());
+  // Pull the string through each stretch between links; a link's ends are corners.
   std::vector<FunnelPortal> portals;
+  glm::dvec3 stretch_start = start;
+  path.corners.push_back(start);
+  auto pull = [&](const glm::dvec3& stretch_end) {
+    const std::vector<glm::dvec3> pulled = pull_string(stretch_start, stretch_end, portals);
+    path.corners.insert(path.corners.end(), pulled.begin() + 1, pulled.end());
+    portals.clear();
+  };
   for (size_t i = 1; i < chain.size(); ++i) {
+    const uint32_t via = nodes.via[chain[i]];
+    if (via & kViaLink) {
+      const LinkExit& e = data.link_exits[via & ~kViaLink];
+      const NavLinkSlot& link = data.links[e.slot];
+      pull(e.reversed ? link.b : link.a);
+      path.links.push_back({link.id, path.corners.size() - 1});
+      stretch_start = e.reversed ? link.a : link.b;
+      path.corners.push_back(stretch_start);
+      continue;
+    }
     const NavTile& t = data.tiles[data.dense_tile[chain[i - 1]]];
-    portals.push_back(oriented(t.portals[nodes.via[chain[i]]]));
+    portals.push_back(oriented(t.portals[via]));
   }
-  path.corners = pull_string(start, end, portals);
+  pull(end);
   for (size_t i = 1; i < path.corners.size(); ++i) {
     path.length += glm::length(path.corners[i] - path.corners[i - 1]);
   }

@@ -76,6 +76,12 @@ struct NavConfig {
   // such floors (and the links between them) are kept, e.g. for an agent
   // that may crouch, and only the slope and climb rules apply.
   bool filter_low_height_spans = true;
+  // Areas, as Recast's area ids: a floor's area is material_areas[its
+  // surface's material] (materials past the end: area 0). NavFilter's costs
+  // and flags are per area, and a rectangle never spans two areas. The
+  // default, empty, puts everything in area 0 (fewest rectangles); give the
+  // materials a filter must tell apart their own areas. [Limit: areas 0 .. 63]
+  std::vector<uint8_t> material_areas;
 };
 
 // An error naming the bad field, or ok.
@@ -100,6 +106,20 @@ struct NavUpdateStats {
   double seconds = 0.0;
 };
 
+// An off-mesh link: a jump, a ladder, a teleporter. Its ends snap to the
+// nearest walkable floor within `radius` (Detour's offMeshConRad); a link
+// whose end has no floor there is kept but unused until an update puts one
+// there (NavMesh::link_attached says which).
+struct NavLink {
+  glm::dvec3 a{0.0}, b{0.0};  // ends [Units: m]
+  bool bidirectional = true;  // false: from a to b only
+  // Cost of taking the link, in metres of walking on cost-1 ground; < 0
+  // means the straight distance between the ends. [Limit: finite]
+  double cost = -1.0;
+  uint16_t flags = 1;   // matched by NavFilter's include/exclude flags
+  double radius = 1.0;  // [Units: m] [Limit: > 0, <= 100]
+};
+
 class NavMesh {
  public:
   // Builds from the whole world; parallel over tiles (TBB). The config is
@@ -110,6 +130,13 @@ class NavMesh {
   // Brings the mesh up to date with `world` after the edits that changed the
   // listed chunks. On error the mesh is left as it was.
   Result<NavUpdateStats> update(const World& world, std::span<const DirtyChunk> dirty);
+
+  // Off-mesh links, added and removed at any time without a rebuild (not
+  // while queries run: like update()). Ids are never reused.
+  Result<uint32_t> add_link(const NavLink& link);
+  Status remove_link(uint32_t id);
+  // Whether both ends of link `id` found a walkable floor (false for unknown ids).
+  bool link_attached(uint32_t id) const;
 
   const NavConfig& config() const;
   const Lattice& lattice() const;
@@ -139,15 +166,46 @@ enum class PathStatus : uint8_t {
 };
 const char* path_status_name(PathStatus status);
 
+// An off-mesh link the path takes: from corners[corner] to corners[corner + 1].
+struct NavPathLink {
+  uint32_t id = 0;
+  size_t corner = 0;
+};
+
 struct NavPath {
   PathStatus status = PathStatus::kComplete;
   std::vector<glm::dvec3> corners;  // start, turning points, end; on the floors [Units: m]
+  std::vector<NavPathLink> links;   // off-mesh links taken, in order
   double length = 0.0;              // of the corner polyline, in 3D [Units: m]
   size_t regions = 0;               // regions in the corridor
   size_t nodes_searched = 0;        // A* nodes used (the budget counts these)
 };
 
+// Which ground a query may use and what it costs, as Detour's dtQueryFilter,
+// keyed by the floor's area (NavConfig::material_areas). A floor is usable
+// when its area's flags share a bit with include_flags and none with
+// exclude_flags; walking a metre on it costs its area's cost. Off-mesh links
+// are matched by their own flags.
+struct NavFilter {
+  std::vector<double> area_cost;     // by area; missing areas cost 1 [Limit: >= 0.01, finite]
+  std::vector<uint16_t> area_flags;  // by area; missing areas have flags 1
+  uint16_t include_flags = 0xFFFF;
+  uint16_t exclude_flags = 0;
+
+  double cost(uint8_t area) const { return area < area_cost.size() ? area_cost[area] : 1.0; }
+  uint16_t flags(uint8_t area) const { return area < area_flags.size() ? area_flags[area] : uint16_t{1}; }
+  bool passes_flags(uint16_t f) const { return (f & include_flags) != 0 && (f & exclude_flags) == 0; }
+  bool passes(uint8_t area) const { return passes_flags(flags(area)); }
+};
+// An error naming the bad cost, or ok.
+Status check_nav_filter(const NavFilter& filter);
+
 struct PathQueryOptions {
+  // Start and goal snap to floors the filter passes; the search uses only
+  // those, at their costs. The straight-line heuristic is scaled by the
+  // cheapest cost, so paths stay shortest by cost (links cheaper than their
+  // length can make them not so).
+  NavFilter filter;
   // How far from the start and goal a floor may be found [Units: m] [Limit: > 0]
   glm::dvec3 search_half_extents{2.0, 2.0, 4.0};  // along x, y, z (the up axis: 4)
 };

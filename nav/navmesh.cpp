@@ -62,6 +62,7 @@ void link_to_relabel(NavData& data, const std::vector<int>& link, const std::vec
   for_tiles(data, cover, [&](NavTile& t) { detail::cover_tile(data, t); });
   for_tiles(data, connect, [&](NavTile& t) { detail::connect_tile(data, t); });
   detail::relabel(data);
+  detail::attach_links(data);
 }
 
 }  // namespace
@@ -86,6 +87,11 @@ Status check_nav_config(const NavConfig& config, const World& world) {
   if (!std::isfinite(config.max_slope_degrees) || config.max_slope_degrees < 0.0 ||
       config.max_slope_degrees > 89.0) {
     return bad_config("max_slope_degrees", config.max_slope_degrees, "must be in [0, 89]");
+  }
+  for (size_t m = 0; m < config.material_areas.size(); ++m) {
+    if (config.material_areas[m] > 63) {
+      return bad_config("material_areas[" + std::to_string(m) + "]", config.material_areas[m], "must be in 0 .. 63");
+    }
   }
   return {};
 }
@@ -116,6 +122,10 @@ Result<NavUpdateStats> NavMesh::update(const World& world, std::span<const Dirty
   if (!same_box) {
     Result<NavMesh> rebuilt = build(world, data.config);
     if (!rebuilt.ok()) return rebuilt.status();
+    // The links outlive the rebuild, ids and all.
+    rebuilt.value().data_->links = std::move(data.links);
+    rebuilt.value().data_->next_link_id = data.next_link_id;
+    detail::attach_links(*rebuilt.value().data_);
     *this = std::move(rebuilt.value());
     stats.full_rebuild = true;
     stats.dirty_tiles = stats.recovered_tiles = data_->tiles.size();

@@ -22,7 +22,7 @@ namespace detail {
 // ---- nearest floor ---------------------------------------------------------
 
 std::optional<FloorHit> nearest_floor(const NavData& data, const glm::dvec3& q,
-                                      const glm::dvec3& reach) {
+                                      const glm::dvec3& reach, const NavFilter* filter) {
   // q and reach in nav coordinates (cells). Rings of columns outward from
   // q's column; stops once a ring is farther than the best hit.
   std::optional<FloorHit> best;
@@ -45,7 +45,7 @@ std::optional<FloorHit> nearest_floor(const NavData& data, const glm::dvec3& q,
         const NavTile& t = data.tiles[size_t(slot)];
         for (uint32_t i = t.column_first[size_t(index)]; i < t.column_first[size_t(index) + 1]; ++i) {
           const NavFloor& f = t.floors[i];
-          if (!f.kept()) continue;
+          if (!f.kept() || (filter && !filter->passes(f.area))) continue;
           if (std::abs(f.height - q.z) > reach.z) continue;
           const glm::dvec3 at(p, f.height);
           const double d = glm::length(at - q);
@@ -83,7 +83,16 @@ Status check_path_input(const glm::dvec3& from, const glm::dvec3& to,
                         const PathQueryOptions& options) {
   if (!detail::is_finite(from)) return not_finite("path start", from);
   if (!detail::is_finite(to)) return not_finite("path goal", to);
+  if (Status s = check_nav_filter(options.filter); !s.ok()) return s;
   return check_extents(options.search_half_extents);
+}
+
+// Detour's H_SCALE (a hair under 1 keeps the heuristic admissible despite
+// float rounding), times the cheapest cost a step can have.
+float heuristic_scale(const NavFilter& filter) {
+  double cheapest = 1.0;  // areas the filter does not list cost 1
+  for (double c : filter.area_cost) cheapest = std::min(cheapest, c);
+  return float(0.999 * cheapest);
 }
 
 uint32_t dense_region(const NavData& data, const detail::FloorHit& hit) {
@@ -94,6 +103,17 @@ uint32_t dense_region(const NavData& data, const detail::FloorHit& hit) {
 }  // namespace
 
 // ---- NavQuery --------------------------------------------------------------
+
+Status check_nav_filter(const NavFilter& filter) {
+  for (size_t m = 0; m < filter.area_cost.size(); ++m) {
+    const double c = filter.area_cost[m];
+    if (!std::isfinite(c) || c < 0.01) {
+      return Status(ErrorCode::kInvalidArgument, "NavFilter.area_cost[" + std::to_string(m) +
+                                                     "] = " + std::to_string(c) + ": must be finite and >= 0.01");
+    }
+  }
+  return {};
+}
 
 namespace {
 
@@ -138,18 +158,20 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
   if (Status st = check_path_input(from, to, options); !st.ok()) return st;
   const NavData& data = *mesh_.data_;
   const glm::dvec3 reach = to_nav_extent(data, options.search_half_extents);
-  const auto start = detail::nearest_floor(data, data.to_nav(from), reach);
+  const auto start = detail::nearest_floor(data, data.to_nav(from), reach, &options.filter);
   if (!start) {
     return no_floor(mesh_, "no walkable floor within " + detail::vec_text(options.search_half_extents) +
                                " m of the path start " + detail::vec_text(from));
   }
   s.reset(data.dense_count);
+  s.filter = options.filter;
+  s.heuristic_scale = heuristic_scale(options.filter);
   s.start = start->point;
   s.start_region = dense_region(data, *start);
-  const uint32_t island = detail::dense_to_region(data, s.start_region).component;
+  const uint32_t island = data.island(detail::dense_to_region(data, s.start_region).component);
   const glm::dvec3 goal_nav = data.to_nav(to);
-  const auto goal = detail::nearest_floor(data, goal_nav, reach);
-  if (goal && detail::dense_to_region(data, dense_region(data, *goal)).component == island) {
+  const auto goal = detail::nearest_floor(data, goal_nav, reach, &options.filter);
+  if (goal && data.island(detail::dense_to_region(data, dense_region(data, *goal)).component) == island) {
     s.target = goal->point;
     s.target_region = dense_region(data, *goal);
     s.goal_reachable = true;
@@ -161,7 +183,7 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
     double best = std::numeric_limits<double>::infinity();
     for (uint32_t r = 0; r < data.dense_count; ++r) {
       const NavRegion& reg = detail::dense_to_region(data, r);
-      if (reg.component != island) continue;
+      if (data.island(reg.component) != island || !options.filter.passes(reg.area)) continue;
       const glm::dvec3 near(std::clamp(aim.x, reg.lo.x - 0.5, reg.hi.x + 0.5),
                             std::clamp(aim.y, reg.lo.y - 0.5, reg.hi.y + 0.5),
                             std::clamp(aim.z, double(reg.height_min), double(reg.height_max)));

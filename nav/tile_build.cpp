@@ -148,6 +148,7 @@ void extract_tile(const NavData& data, const World& world, NavTile& tile) {
         f.height = float(depth);
         f.ceiling = std::numeric_limits<float>::infinity();
         f.steep_normal = decode_normal(p.normal)[data.up] < data.min_normal_up;
+        f.area = p.material < data.config.material_areas.size() ? data.config.material_areas[p.material] : 0;
         tile.floors.push_back(f);
         open_floor = true;
       }
@@ -394,7 +395,8 @@ struct TileFloors {
     const int j = at(nu, nv, f.link[d]);
     if (j < 0) return -1;
     const NavFloor& g = tile.floors[size_t(j)];
-    return g.region == kUnassigned ? j : -1;
+    // One area per rectangle, so a filter's cost and flags hold for all of it.
+    return g.region == kUnassigned && g.area == f.area ? j : -1;
   }
 };
 
@@ -444,6 +446,7 @@ void cover_tile(const NavData& data, NavTile& tile) {
         NavRegion r;
         r.lo = base + glm::ivec2(lu, lv);
         r.hi = r.lo + glm::ivec2(int(row.size()) - 1, rows - 1);
+        r.area = tile.floors[size_t(i)].area;
         tile.regions.push_back(r);
       }
     }

@@ -40,6 +40,7 @@ struct NavFloor {
   bool steep_normal = false;  // the stored normal is steeper than max_slope
   bool walkable = false;      // slope walkable (its normal or a linked neighbour's)
   uint16_t region = kNoRegion;  // rectangle (local to the tile) holding it
+  uint8_t area = 0;             // NavConfig::material_areas of its surface's material
 
   bool kept() const { return region != kNoRegion; }  // walkable and survived erosion
 };
@@ -53,6 +54,7 @@ struct NavRegion {
   uint32_t first_portal = 0;  // into NavTile::portals
   uint32_t portal_count = 0;
   uint32_t component = 0;     // connected island id (valid after relabelling)
+  uint8_t area = 0;           // every floor of a rectangle has the same
 };
 
 // A directed portal from a region to a neighbouring one: the shared side's
@@ -82,6 +84,23 @@ struct NavTile {
   size_t memory_bytes() const;
 };
 
+// An off-mesh link and where its ends landed (dense regions, nav points).
+struct NavLinkSlot {
+  uint32_t id = 0;
+  NavLink link;
+  bool attached = false;
+  uint32_t region_a = 0, region_b = 0;
+  glm::dvec3 a{0.0}, b{0.0};
+};
+
+// A way out of a region by a link: its slot, and whether it runs b -> a.
+struct LinkExit {
+  uint32_t region = 0;
+  uint32_t slot = 0;
+  bool reversed = false;
+  bool operator<(const LinkExit& o) const { return region < o.region; }
+};
+
 struct NavData {
   NavConfig config;
   Lattice lattice;
@@ -102,6 +121,15 @@ struct NavData {
   uint32_t dense_count = 0;
   uint32_t dense_floor_count = 0;
   uint32_t component_count = 0;
+  // Off-mesh links, the exits they give each region (sorted by region), and
+  // per component the island it joins through links (the island check).
+  std::vector<NavLinkSlot> links;
+  uint32_t next_link_id = 0;
+  std::vector<LinkExit> link_exits;
+  std::vector<uint32_t> island_of_component;
+  uint32_t island(uint32_t component) const {
+    return component < island_of_component.size() ? island_of_component[component] : component;
+  }
 
   int tile_slot(const glm::ivec2& tile) const {
     const glm::ivec2 t = tile - tile_origin;
@@ -152,5 +180,8 @@ void cover_tile(const NavData& data, NavTile& tile);
 void connect_tile(const NavData& data, NavTile& tile);
 // Dense numbering and connected components over all tiles.
 void relabel(NavData& data);
+// Snaps every link's ends to floors and rebuilds link_exits and the islands
+// (nav/links.cpp); after every relabel and every link change.
+void attach_links(NavData& data);
 
 }  // namespace ldc::detail

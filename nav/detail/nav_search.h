@@ -20,9 +20,10 @@ struct FloorHit {
   double distance = 0.0;
 };
 
-// The kept floor nearest q within reach (both in cells), searched in rings of columns.
+// The kept floor nearest q within reach (both in cells), searched in rings
+// of columns; only floors the filter passes, when one is given.
 std::optional<FloorHit> nearest_floor(const NavData& data, const glm::dvec3& q,
-                                      const glm::dvec3& reach);
+                                      const glm::dvec3& reach, const NavFilter* filter = nullptr);
 
 // The region of a dense index (and its tile slot when asked).
 const NavRegion& dense_to_region(const NavData& data, uint32_t dense, uint32_t* slot = nullptr);
@@ -34,7 +35,7 @@ struct SearchNodes {
   std::vector<uint32_t> stamp;
   std::vector<float> cost;           // g
   std::vector<uint32_t> parent;      // node index, or UINT32_MAX
-  std::vector<uint32_t> via;         // region search: portal index in the parent's tile
+  std::vector<uint32_t> via;         // region search: portal index in the parent's tile, or kViaLink | link exit
   std::vector<glm::vec3> position;   // where the node is entered
   std::vector<uint8_t> closed;
   std::vector<std::pair<float, uint32_t>> heap;  // (f, node), min-heap by f
@@ -56,8 +57,12 @@ struct GridSearchState {
 NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& goal,
                     int max_nodes, GridSearchState& state);
 
+inline constexpr uint32_t kViaLink = 0x80000000u;
+
 struct NavSearch {
   SearchNodes nodes;
+  NavFilter filter;
+  float heuristic_scale = 0.999f;  // Detour's H_SCALE times the cheapest cost
   GridSearchState grid;
   bool active = false;
   bool done = false;
@@ -73,6 +78,9 @@ struct NavSearch {
   void push_start(uint32_t region, const glm::dvec3& at, double to_target);
   // Expands the cheapest open node; false when the search is over.
   bool expand_one(const NavData& data, int max_nodes);
+  // Offers node m, entered at `at` from n with cost g so far.
+  void relax(const NavData& data, uint32_t n, uint32_t m, const glm::vec3& at, float g, uint32_t via,
+             int max_nodes);
   // The corridor to the target (or the best node) pulled taut; lengths in cells.
   NavPath make_path(const NavData& data) const;
 };
