@@ -7,6 +7,9 @@ if(CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
       -Wno-missing-field-initializers>  # designated initializers of config structs
     -ffp-contract=off)  # no fused multiply-add: the same bits on every machine
 endif()
+if(LDC_WERROR AND CMAKE_CXX_COMPILER_ID MATCHES "GNU|Clang")
+  target_compile_options(ldc_build_flags INTERFACE -Werror)
+endif()
 if(LDC_SANITIZE)
   target_compile_options(ldc_build_flags INTERFACE
     -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)

@@ -14,7 +14,16 @@ for target in "${targets[@]}"; do
   corpus=$(mktemp -d)
   cp fuzz/corpus/${target#fuzz_}/* "$corpus"/ 2>/dev/null || true
   echo "fuzzing $target for ${seconds}s"
-  ./build-fuzz/fuzz/$target "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
-    -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 2>&1 | tail -n 12
-  rm -rf "$corpus"
+  log=$(mktemp)
+  # The whole log when the fuzzer finds anything (the report and the input that
+  # caused it, saved as crash-* here); the final stats otherwise.
+  if ! ./build-fuzz/fuzz/$target "$corpus" -max_total_time="$seconds" -rss_limit_mb=2048 \
+      -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 >"$log" 2>&1; then
+    cat "$log"
+    echo "fuzz.sh: $target found a failure (its input is saved as crash-*/timeout-*/oom-* here);" \
+      "add it to fuzz/corpus/${target#fuzz_}/ and as a named regression test" >&2
+    exit 1
+  fi
+  tail -n 12 "$log"
+  rm -rf "$corpus" "$log"
 done
