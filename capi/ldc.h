@@ -60,7 +60,7 @@
 extern "C" {
 #endif
 
-#define LDC_C_API_VERSION 1
+#define LDC_C_API_VERSION 2
 
 /* ------------------------------------------------------------------------ */
 /* Status and version                                                        */
@@ -282,6 +282,14 @@ typedef struct ldc_nav_config {
   int32_t max_nodes;        /* A* node budget [16 .. 1 << 20] [default 2048] */
   double search_half_extents[3]; /* how far from start/goal a floor is looked for [m] [default 2, 2, 4] */
   uint32_t filters;         /* Recast's span filters, LDC_NAV_FILTER_* bits [default: all three] */
+  /* Areas, as Recast's area ids: the floors of material m are in area
+   * material_areas[m] (materials past the count: area 0). The filter
+   * (ldc_nav_filter) gives each area a cost and flags; a material a filter
+   * must tell apart needs an area of its own. Copied by
+   * ldc_world_set_nav_config. [each 0 .. 63] [count 0 .. 65536]
+   * [default NULL, 0: everything in area 0] */
+  const uint8_t* material_areas;
+  uint32_t material_area_count;
 } ldc_nav_config;
 
 /* NavConfig's filter_* fields (nav/nav.h). */
@@ -290,8 +298,49 @@ typedef struct ldc_nav_config {
 #define LDC_NAV_FILTER_LOW_HEIGHT 4u  /* floors under less than agent_height are not */
 
 LDC_C_API void ldc_nav_config_default(ldc_nav_config* config);
-/* Sets the agent; the navigation data is rebuilt at the next path query. */
+/* Sets the agent; the navigation data is rebuilt at the next path query
+ * (off-mesh links stay: they are added to the new data). */
 LDC_C_API ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* config);
+
+/* Which ground a path may use and what it costs, by area (the config's
+ * material_areas), as Detour's dtQueryFilter. A floor is usable when its
+ * area's flags share a bit with include_flags and none with exclude_flags;
+ * a metre on it costs its area's cost. Off-mesh links are matched by their
+ * own flags. The start and goal snap only to usable floors. */
+typedef struct ldc_nav_filter {
+  const double* area_costs;    /* by area; areas past the count cost 1 [each finite, >= 0.01] */
+  uint32_t area_cost_count;    /* [0 .. 64] */
+  const uint16_t* area_flags;  /* by area; areas past the count have flags 1 */
+  uint32_t area_flag_count;    /* [0 .. 64] */
+  uint16_t include_flags;      /* [default 0xFFFF] */
+  uint16_t exclude_flags;      /* [default 0] */
+} ldc_nav_filter;
+
+LDC_C_API void ldc_nav_filter_default(ldc_nav_filter* filter);
+/* The filter of later ldc_world_find_path calls (copied); NULL resets it to
+ * the default (every area usable at cost 1). */
+LDC_C_API ldc_status ldc_world_set_nav_filter(ldc_world* world, const ldc_nav_filter* filter);
+
+/* An off-mesh link: a jump, a ladder, a teleporter. Each end snaps to the
+ * nearest walkable floor within `radius`; a link with an end on no floor is
+ * kept but unused until an edit puts a floor there. */
+typedef struct ldc_nav_link {
+  double a[3], b[3];      /* ends [m] [finite] */
+  double cost;            /* of taking it, in metres of cost-1 ground [finite; < 0: the straight distance] [default -1] */
+  double radius;          /* [m] [> 0, <= 100] [default 1] */
+  int32_t bidirectional;  /* 1: both ways; 0: from a to b only [default 1] */
+  uint16_t flags;         /* matched by the filter's include / exclude flags [default 1] */
+} ldc_nav_link;
+
+LDC_C_API void ldc_nav_link_default(ldc_nav_link* link);
+/* Adds a link to the world's navigation (kept across edits and nav config
+ * changes); its id goes to *id_out. Ids are never reused. */
+LDC_C_API ldc_status ldc_world_add_nav_link(ldc_world* world, const ldc_nav_link* link, uint32_t* id_out);
+/* Removes link `id`; LDC_INVALID_ARGUMENT for an unknown id. */
+LDC_C_API ldc_status ldc_world_remove_nav_link(ldc_world* world, uint32_t id);
+/* *attached = 1 when both ends of link `id` found a walkable floor (builds or
+ * updates the navigation data first, as a path query does), 0 when not. */
+LDC_C_API ldc_status ldc_world_nav_link_attached(ldc_world* world, uint32_t id, int32_t* attached);
 
 typedef enum ldc_path_status {
   LDC_PATH_COMPLETE = 0,     /* reaches the goal */

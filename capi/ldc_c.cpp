@@ -14,11 +14,13 @@
 #include <cmath>
 #include <cstring>
 #include <exception>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <new>
 #include <optional>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <tbb/global_control.h>
@@ -106,6 +108,17 @@ struct ldc_world {
   ldc::LiveWorld live;
   ldc::NavConfig nav_config;  // the agent of the nav mesh built at the next path query
   glm::dvec3 search_half_extents{2.0, 2.0, 4.0};
+  ldc::NavFilter nav_filter;  // of every path query
+  // Off-mesh links by the caller's id, each with its id on the current nav
+  // mesh (none while the mesh is not built). A mesh built afresh (the first
+  // query, or one after ldc_world_set_nav_config) starts without links: they
+  // are added again then, so the caller's ids outlive it.
+  struct Link {
+    ldc::NavLink link;
+    std::optional<uint32_t> mesh_id;
+  };
+  std::map<uint32_t, Link> nav_links;
+  uint32_t next_link_id = 0;
   std::vector<ldc_cascades*> cascades;
 
   const ldc::World& world() const { return live.world(); }
@@ -484,6 +497,18 @@ ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* conf
     c.filter_low_hanging_obstacles = (config->filters & LDC_NAV_FILTER_LOW_HANGING) != 0;
     c.filter_ledge_spans = (config->filters & LDC_NAV_FILTER_LEDGES) != 0;
     c.filter_low_height_spans = (config->filters & LDC_NAV_FILTER_LOW_HEIGHT) != 0;
+    if (config->material_area_count > 65536) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_set_nav_config: material_area_count " +
+                                            std::to_string(config->material_area_count) +
+                                            " must be at most 65536 (one area per 16-bit material id)");
+    }
+    if (config->material_area_count > 0 && !config->material_areas) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_set_nav_config: material_areas is NULL with material_area_count " +
+                                            std::to_string(config->material_area_count));
+    }
+    if (config->material_area_count > 0) {
+      c.material_areas.assign(config->material_areas, config->material_areas + config->material_area_count);
+    }
     if (config->filters & ~(LDC_NAV_FILTER_LOW_HANGING | LDC_NAV_FILTER_LEDGES | LDC_NAV_FILTER_LOW_HEIGHT)) {
       return fail(LDC_INVALID_ARGUMENT, "ldc_world_set_nav_config: filters has unknown bits " +
                                             std::to_string(config->filters));
@@ -499,6 +524,7 @@ ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* conf
                   "ldc_world_set_nav_config: search_half_extents must be finite and > 0 on every axis");
     }
     world->live.disable_nav();  // rebuilt with these at the next path query
+    for (auto& [id, l] : world->nav_links) l.mesh_id.reset();
     if (ldc_status s = from_status(world->live.set_max_path_nodes(config->max_nodes)); s != LDC_OK) return s;
     world->nav_config = c;
     world->search_half_extents = half;
@@ -507,10 +533,21 @@ ldc_status ldc_world_set_nav_config(ldc_world* world, const ldc_nav_config* conf
 }
 
 // The path query on a nav mesh built on first use and brought up to date with the edits since.
+// A mesh built afresh gets the world's off-mesh links.
 static ldc::Result<ldc::NavQuery*> synced_path_query(ldc_world* world) {
   if (!world->live.nav()) {
     ldc::Status s = world->live.enable_nav(world->nav_config);
     if (!s.ok()) return s;
+    ldc::NavMesh& nav = *world->live.nav();
+    for (auto& [id, l] : world->nav_links) {
+      ldc::Result<uint32_t> added = nav.add_link(l.link);  // checked when the caller added it
+      if (!added.ok()) {
+        world->live.disable_nav();
+        for (auto& [other, m] : world->nav_links) m.mesh_id.reset();
+        return ldc::Status(added.status().code(), "nav link " + std::to_string(id) + ": " + added.status().message());
+      }
+      l.mesh_id = added.value();
+    }
   }
   return world->live.path_query();
 }
@@ -525,6 +562,7 @@ ldc_status ldc_world_find_path(ldc_world* world, const double from[3], const dou
     if (!query.ok()) return from_status(query.status());
     ldc::PathQueryOptions options;
     options.search_half_extents = world->search_half_extents;
+    options.filter = world->nav_filter;
     ldc::Result<ldc::NavPath> path = (*query)->find_path(vec3(from), vec3(to), options);
     if (!path.ok()) {
       const bool no_floor = path.status().message().find("no walkable floor") != std::string::npos;
@@ -545,6 +583,147 @@ ldc_status ldc_world_find_path(ldc_world* world, const double from[3], const dou
     if (corners) {
       for (size_t i = 0; i < p.corners.size(); ++i) put(p.corners[i], corners + 3 * i);
     }
+    return LDC_OK;
+  });
+}
+
+void ldc_nav_filter_default(ldc_nav_filter* filter) {
+  if (!filter) return;
+  const ldc::NavFilter d;
+  *filter = ldc_nav_filter{};
+  filter->include_flags = d.include_flags;
+  filter->exclude_flags = d.exclude_flags;
+}
+
+ldc_status ldc_world_set_nav_filter(ldc_world* world, const ldc_nav_filter* filter) {
+  return guarded("ldc_world_set_nav_filter", [&] {
+    if (!world) return null_argument("ldc_world_set_nav_filter", "world");
+    ldc::NavFilter f;
+    if (filter) {
+      // 64 areas (0 .. 63): a longer array is a wrong count, not more areas.
+      for (auto [count, set, name] : {std::tuple{filter->area_cost_count, filter->area_costs != nullptr, "area_cost"},
+                                      std::tuple{filter->area_flag_count, filter->area_flags != nullptr, "area_flag"}}) {
+        if (count > 64) {
+          return fail(LDC_INVALID_ARGUMENT, std::string("ldc_world_set_nav_filter: ") + name + "_count " +
+                                                std::to_string(count) + " must be at most 64 (areas 0 .. 63)");
+        }
+        if (count > 0 && !set) {
+          return fail(LDC_INVALID_ARGUMENT, std::string("ldc_world_set_nav_filter: ") + name + "s is NULL with " +
+                                                name + "_count " + std::to_string(count));
+        }
+      }
+      if (filter->area_cost_count > 0) {
+        f.area_cost.assign(filter->area_costs, filter->area_costs + filter->area_cost_count);
+      }
+      if (filter->area_flag_count > 0) {
+        f.area_flags.assign(filter->area_flags, filter->area_flags + filter->area_flag_count);
+      }
+      f.include_flags = filter->include_flags;
+      f.exclude_flags = filter->exclude_flags;
+      for (size_t i = 0; i < f.area_cost.size(); ++i) {
+        if (!(f.area_cost[i] >= 0.01) || !std::isfinite(f.area_cost[i])) {
+          return fail(LDC_INVALID_ARGUMENT, "ldc_world_set_nav_filter: area_costs[" + std::to_string(i) + "] = " +
+                                                std::to_string(f.area_cost[i]) + " must be a finite number >= 0.01");
+        }
+      }
+      if (ldc_status s = from_status(ldc::check_nav_filter(f)); s != LDC_OK) return s;
+    }
+    world->nav_filter = std::move(f);
+    return LDC_OK;
+  });
+}
+
+void ldc_nav_link_default(ldc_nav_link* link) {
+  if (!link) return;
+  const ldc::NavLink d;
+  *link = ldc_nav_link{};
+  put(d.a, link->a);
+  put(d.b, link->b);
+  link->bidirectional = d.bidirectional ? 1 : 0;
+  link->cost = d.cost;
+  link->flags = d.flags;
+  link->radius = d.radius;
+}
+
+ldc_status ldc_world_add_nav_link(ldc_world* world, const ldc_nav_link* link, uint32_t* id_out) {
+  return guarded("ldc_world_add_nav_link", [&] {
+    if (!world) return null_argument("ldc_world_add_nav_link", "world");
+    if (!link) return null_argument("ldc_world_add_nav_link", "link");
+    if (!id_out) return null_argument("ldc_world_add_nav_link", "id_out");
+    // Checked here, not only by NavMesh::add_link: the mesh may not be built
+    // yet, and the caller's names are the fields of ldc_nav_link.
+    for (auto [end, name] : {std::pair{link->a, "a"}, std::pair{link->b, "b"}}) {
+      if (!std::isfinite(end[0]) || !std::isfinite(end[1]) || !std::isfinite(end[2])) {
+        return fail(LDC_INVALID_ARGUMENT, std::string("ldc_world_add_nav_link: link->") + name +
+                                              " must be finite (" + std::to_string(end[0]) + ", " +
+                                              std::to_string(end[1]) + ", " + std::to_string(end[2]) + ")");
+      }
+    }
+    if (!std::isfinite(link->cost)) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_add_nav_link: link->cost " + std::to_string(link->cost) +
+                                            " must be finite (< 0: the straight distance)");
+    }
+    if (!(link->radius > 0.0 && link->radius <= 100.0)) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_add_nav_link: link->radius " + std::to_string(link->radius) +
+                                            " must be in (0, 100] m");
+    }
+    if (link->bidirectional != 0 && link->bidirectional != 1) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_add_nav_link: link->bidirectional " +
+                                            std::to_string(link->bidirectional) + " must be 0 or 1");
+    }
+    ldc_world::Link l;
+    l.link.a = vec3(link->a);
+    l.link.b = vec3(link->b);
+    l.link.bidirectional = link->bidirectional != 0;
+    l.link.cost = link->cost;
+    l.link.flags = link->flags;
+    l.link.radius = link->radius;
+    if (world->next_link_id == UINT32_MAX) {
+      return fail(LDC_TOO_LARGE, "ldc_world_add_nav_link: every link id has been used");
+    }
+    const uint32_t id = world->next_link_id;
+    auto it = world->nav_links.emplace(id, l).first;
+    if (ldc::NavMesh* nav = world->live.nav()) {  // built: the link joins it now
+      ldc::Result<uint32_t> added = nav->add_link(l.link);
+      if (!added.ok()) {
+        world->nav_links.erase(it);
+        return from_status(added.status());
+      }
+      it->second.mesh_id = added.value();
+    }
+    ++world->next_link_id;
+    *id_out = id;
+    return LDC_OK;
+  });
+}
+
+ldc_status ldc_world_remove_nav_link(ldc_world* world, uint32_t id) {
+  return guarded("ldc_world_remove_nav_link", [&] {
+    if (!world) return null_argument("ldc_world_remove_nav_link", "world");
+    auto it = world->nav_links.find(id);
+    if (it == world->nav_links.end()) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_remove_nav_link: no nav link with id " + std::to_string(id));
+    }
+    ldc::NavMesh* nav = world->live.nav();
+    if (nav && it->second.mesh_id) {
+      if (ldc_status s = from_status(nav->remove_link(*it->second.mesh_id)); s != LDC_OK) return s;
+    }
+    world->nav_links.erase(it);
+    return LDC_OK;
+  });
+}
+
+ldc_status ldc_world_nav_link_attached(ldc_world* world, uint32_t id, int32_t* attached) {
+  return guarded("ldc_world_nav_link_attached", [&] {
+    if (!world) return null_argument("ldc_world_nav_link_attached", "world");
+    if (!attached) return null_argument("ldc_world_nav_link_attached", "attached");
+    if (!world->nav_links.count(id)) {
+      return fail(LDC_INVALID_ARGUMENT, "ldc_world_nav_link_attached: no nav link with id " + std::to_string(id));
+    }
+    ldc::Result<ldc::NavQuery*> query = synced_path_query(world);  // builds or updates the mesh
+    if (!query.ok()) return from_status(query.status());
+    const std::optional<uint32_t> mesh_id = world->nav_links.at(id).mesh_id;
+    *attached = mesh_id && world->live.nav()->link_attached(*mesh_id) ? 1 : 0;
     return LDC_OK;
   });
 }

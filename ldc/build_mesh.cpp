@@ -259,6 +259,11 @@ Result<World> build_from_mesh(const TriangleMesh& mesh, const GridConfig& grid,
     record_build_report(world, report);
     world.set_metadata("source", "mesh");
     if (config.mode != BuildMode::kSolid) world.set_metadata("build.mode", build_mode_name(config.mode));
+    // The materials' names (OBJ usemtl), as the landscape records its own:
+    // material.<id> = name, so tools can name materials (ldc path --filter).
+    for (size_t id = 0; id < mesh.material_names.size(); ++id) {
+      world.set_metadata("material." + std::to_string(id), mesh.material_names[id]);
+    }
     if (report_out) *report_out = report;
     return world;
   } catch (const std::bad_alloc&) {

@@ -278,6 +278,7 @@ Status LiveWorld::set_max_path_nodes(int max_nodes) {
 
 const ChunkedMesh* LiveWorld::meshes() const { return state_->meshes ? &*state_->meshes : nullptr; }
 const NavMesh* LiveWorld::nav() const { return state_->nav ? &*state_->nav : nullptr; }
+NavMesh* LiveWorld::nav() { return state_->nav ? &*state_->nav : nullptr; }
 
 Result<NavQuery*> LiveWorld::path_query(Context* ctx) {
   if (!state_->nav) {

@@ -155,6 +155,10 @@ class LiveWorld {
   // that consumer: call update() (or update_meshes / update_nav) first.
   const ChunkedMesh* meshes() const;
   const NavMesh* nav() const;
+  // The nav mesh for changes that need no edit: off-mesh links
+  // (NavMesh::add_link / remove_link; not while its path query runs). They
+  // are kept by update_nav; a mesh enable_nav builds again starts with none.
+  NavMesh* nav();
   // The path query on the nav mesh (null when nav is off); it keeps its
   // search arrays between paths. Brings the nav mesh up to date first.
   Result<NavQuery*> path_query(Context* ctx = nullptr);

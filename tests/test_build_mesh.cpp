@@ -8,6 +8,7 @@
 #include <tbb/global_control.h>
 
 #include "ldc/build.h"
+#include "meshio/meshio.h"
 #include "test_util.h"
 
 namespace ldc {
@@ -236,6 +237,32 @@ TEST(MeshBuild, MaterialsFollowTheirTriangles) {
   EXPECT_EQ(pts[1].material, 7);
   EXPECT_GT(pts[1].normal.x, 0.99f);
   EXPECT_LT(pts[0].normal.x, -0.99f);
+}
+
+// OBJ usemtl names become world metadata material.<id> = name (as the
+// landscape's), in both readings, so tools can name materials.
+TEST(MeshBuild, MaterialNamesAreRecordedAsMetadata) {
+  const char* obj =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n"
+      "usemtl stone\nf 1 4 3 2\nf 1 2 6 5\nf 2 3 7 6\nf 3 4 8 7\nf 4 1 5 8\n"
+      "usemtl moss\nf 5 6 7 8\n";
+  const TriangleMesh m = parse_obj(obj, "cube.obj").value();
+  ASSERT_EQ(m.material_names, (std::vector<std::string>{"stone", "moss"}));
+  for (BuildMode mode : {BuildMode::kSolid, BuildMode::kAuto}) {
+    BuildConfig config;
+    config.mode = mode;
+    const World w = build_from_mesh(m, lattice_at_origin(0.125), config).value();
+    EXPECT_EQ(w.metadata_value("material.0"), "stone") << build_mode_name(mode);
+    EXPECT_EQ(w.metadata_value("material.1"), "moss") << build_mode_name(mode);
+    EXPECT_EQ(w.metadata_value("material.2"), "") << build_mode_name(mode);
+    // The top face (+z) carries moss's id.
+    const auto pts = w.ray_points(2, {4, 4});
+    ASSERT_EQ(pts.size(), 2u) << build_mode_name(mode);
+    EXPECT_EQ(pts[1].material, 1) << build_mode_name(mode);
+  }
+  // A mesh without names records none.
+  const World plain = build_from_mesh(box_mesh({0, 0, 0}, {1, 1, 1}), lattice_at_origin(0.125)).value();
+  for (const auto& [key, value] : plain.metadata()) EXPECT_NE(key.rfind("material.", 0), 0u) << key;
 }
 
 TEST(MeshBuild, BadInputIsRefusedWithAMessageAndNoWorld) {

@@ -1,11 +1,15 @@
 // ldc path: a walking path between two points of a world or a mesh level (JSON out).
 #include <cstdio>
+#include <map>
 #include <memory>
+#include <optional>
 
 #include "common.h"
+#include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
 #include "meshio/meshio.h"
 #include "nav/nav.h"
+#include "nav_inputs.h"
 
 namespace ldc::tool {
 namespace {
@@ -22,11 +26,13 @@ Output (stdout, or -o FILE), drawable with `ldc render --overlay FILE`:
    (the goal's floor, or where a partial path stops), "points": [start, end],
    "regions", "nodes_searched",
    "nav": {"floors", "walkable", "regions", "components", "memory_bytes", "build_seconds"},
-   "query_seconds", "start_inside_solid", "goal_inside_solid"}
+   "query_seconds", "start_inside_solid", "goal_inside_solid",
+   "links_taken": [{"id", "corner"}, ...] (off-mesh links of --links taken: see below)}
 A start or goal inside solid geometry (a wall, or deeper than --max-climb in the ground) is snapped to the nearest walkable floor
 like any other point, with a warning on stderr and *_inside_solid true in the JSON.
-"unreachable": the goal lies on another walkable island (or has no floor near it); the path
-ends at the start island's point nearest the goal. "out_of_nodes": the search spent --max-nodes
+"unreachable": the goal lies on another walkable island (or has no floor near it, or --filter
+leaves no way to it); the path ends at the start island's point nearest the goal.
+"out_of_nodes": the search spent --max-nodes
 (default 2048, the library's budget) before reaching the goal; the path ends at the explored region
 nearest the goal: raise --max-nodes for long paths. The exit status is 0 for every status.
 )";
@@ -40,6 +46,8 @@ struct PathArgs {
   MeshReadingArgs reading;
   int max_nodes = 2048;  // NavQuery's default budget (nav/nav.h)
   NavConfig agent;
+  std::string filter_file;  // --filter (nav_inputs.h)
+  std::string links_file;   // --links
 };
 
 Result<World> load_input(const PathArgs& a, Context* ctx) {
@@ -57,10 +65,16 @@ Result<World> load_input(const PathArgs& a, Context* ctx) {
   return build_from_mesh(mesh.value(), grid, config.value(), ctx);
 }
 
-nlohmann::json path_json(const NavPath& path, const NavMesh& nav, double build_seconds,
-                         double query_seconds) {
+// link_index: the NavMesh's link ids -> their index in the --links file.
+nlohmann::json path_json(const NavPath& path, const NavMesh& nav, const std::map<uint32_t, size_t>& link_index,
+                         double build_seconds, double query_seconds) {
   nlohmann::json points = nlohmann::json::array();
   for (const glm::dvec3& p : path.corners) points.push_back(vec_json(p));
+  nlohmann::json links = nlohmann::json::array();
+  for (const NavPathLink& l : path.links) {
+    auto it = link_index.find(l.id);
+    links.push_back({{"id", it != link_index.end() ? it->second : size_t(l.id)}, {"corner", l.corner}});
+  }
   const NavStats s = nav.stats();
   return {{"status", path_status_name(path.status)},
           {"length", path.length},
@@ -73,7 +87,8 @@ nlohmann::json path_json(const NavPath& path, const NavMesh& nav, double build_s
           {"nav", {{"floors", s.floors}, {"walkable", s.walkable}, {"regions", s.regions},
                    {"components", s.components}, {"memory_bytes", s.memory_bytes},
                    {"build_seconds", build_seconds}}},
-          {"query_seconds", query_seconds}};
+          {"query_seconds", query_seconds},
+          {"links_taken", links}};
 }
 
 void print_summary(std::FILE* f, const nlohmann::json& j) {
@@ -84,6 +99,35 @@ void print_summary(std::FILE* f, const nlohmann::json& j) {
   std::fprintf(f, "nav: %zu walkable floors, %zu regions, %zu islands, built in %.1f ms\n",
                j["nav"]["walkable"].get<size_t>(), j["nav"]["regions"].get<size_t>(),
                j["nav"]["components"].get<size_t>(), j["nav"]["build_seconds"].get<double>() * 1e3);
+  const nlohmann::json& links = j["links_taken"];
+  if (links.empty()) return;
+  std::string list;
+  for (const nlohmann::json& l : links) {
+    const size_t k = l["corner"].get<size_t>();
+    list += (list.empty() ? "" : ", ") + std::string("link ") + std::to_string(l["id"].get<size_t>()) +
+            " (corners " + std::to_string(k) + " to " + std::to_string(k + 1) + ")";
+  }
+  std::fprintf(f, "links: %zu taken: %s\n", links.size(), list.c_str());
+}
+
+// Adds the links of a --links file; warns about those with an end on no
+// walkable floor (kept, unused). Returns the NavMesh id -> file index map.
+Result<std::map<uint32_t, size_t>> add_links(NavMesh& nav, const LinksFile& file) {
+  std::map<uint32_t, size_t> index;
+  NavQuery probe(nav);
+  for (size_t i = 0; i < file.links.size(); ++i) {
+    const NavLink& link = file.links[i];
+    Result<uint32_t> id = nav.add_link(link);
+    if (!id.ok()) return Status(id.status().code(), link_context(file, i) + ": " + id.status().message());
+    index[id.value()] = i;
+    if (nav.link_attached(id.value())) continue;
+    for (const auto& [name, end] : {std::pair{"a", link.a}, std::pair{"b", link.b}}) {
+      if (probe.nearest_walkable(end, glm::dvec3(link.radius)).ok()) continue;
+      std::fprintf(stderr, "ldc path: warning: %s: end %s (%g, %g, %g) has no walkable floor within %g m; unused\n",
+                   link_context(file, i).c_str(), name, end.x, end.y, end.z, link.radius);
+    }
+  }
+  return index;
 }
 
 // A point asked for inside a wall or deep in the ground is snapped to the
@@ -113,23 +157,60 @@ int run_path(PathArgs a, const CommonOptions& common) {
   Result<int> up = parse_up_axis(a.up, has_ldc_extension(a.input) ? kLdcUpAxis : 1);
   if (!up.ok()) return fail("path", up.status());
   a.agent.up_axis = up.value();
+  // The filter and links files are checked in full before the level is built.
+  std::optional<FilterFile> filter_file;
+  if (!a.filter_file.empty()) {
+    Result<FilterFile> f = read_filter_file(a.filter_file);
+    if (!f.ok()) return fail("path", f.status());
+    filter_file = std::move(f).value();
+  }
+  LinksFile links;
+  if (!a.links_file.empty()) {
+    Result<LinksFile> l = read_links_file(a.links_file);
+    if (!l.ok()) return fail("path", l.status());
+    links = std::move(l).value();
+    for (size_t i = 0; filter_file && filter_file->excludes() && i < links.links.size(); ++i) {
+      if (links.links[i].flags & kExcludedAreaFlag) {
+        return fail("path", Status(ErrorCode::kInvalidArgument,
+                                   link_context(links, i) + ": field 'flags' is " + std::to_string(links.links[i].flags) +
+                                       ": uses flag 32768, which \"exclude\": true in " + filter_file->path +
+                                       " reserves for excluded materials"));
+      }
+    }
+  }
   ProgressBar bar(!common.quiet);
   Result<World> world = load_input(a, bar.context());
   if (!world.ok()) return fail("path", world.status());
+  PathQueryOptions options;
+  if (filter_file) {
+    Result<ResolvedFilter> resolved = resolve_filter(*filter_file, world.value());
+    if (!resolved.ok()) return fail("path", resolved.status());
+    a.agent.material_areas = resolved->material_areas;
+    options.filter = resolved->filter;
+  }
   ScopedTimer build_timer(nullptr, "");
   Result<NavMesh> nav = NavMesh::build(world.value(), a.agent, bar.context());
   const double build_seconds = build_timer.seconds();
   bar.finish();
   if (!nav.ok()) return fail("path", nav.status());
+  Result<std::map<uint32_t, size_t>> link_index = add_links(nav.value(), links);
+  if (!link_index.ok()) return fail("path", link_index.status());
   NavQuery query(nav.value(), a.max_nodes);
-  PathQueryOptions options;
   options.search_half_extents = glm::dvec3(2.0);
   options.search_half_extents[a.agent.up_axis] = 4.0;
   ScopedTimer query_timer(nullptr, "");
   Result<NavPath> path = query.find_path(from, to, options);
   const double query_seconds = query_timer.seconds();
-  if (!path.ok()) return fail("path", path.status());
-  nlohmann::json out = path_json(path.value(), nav.value(), build_seconds, query_seconds);
+  if (!path.ok()) {
+    // A start on floors the filter does not pass has "no walkable floor": say that there is one.
+    Result<NavPoint> unfiltered = query.nearest_walkable(from, options.search_half_extents);
+    if (filter_file && unfiltered.ok() && path.status().message().find("no walkable floor") != std::string::npos) {
+      return fail("path", path.status().to_string() + " that " + filter_file->path + " allows (the floor at " +
+                              detail::vec_text(unfiltered->position) + " is one it excludes)");
+    }
+    return fail("path", path.status());
+  }
+  nlohmann::json out = path_json(path.value(), nav.value(), link_index.value(), build_seconds, query_seconds);
   warn_if_inside_solid(world.value(), a.agent, "start", from, path.value().corners.front(), out, common.quiet);
   warn_if_inside_solid(world.value(), a.agent, "goal", to, path.value().corners.back(), out, common.quiet);
   if (a.output.empty()) {
@@ -171,8 +252,10 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
                 "Keep floors with less than --agent-height above them (Recast's low-height filter)");
   cmd->add_option("--max-nodes", args->max_nodes, "A* node budget in regions, clamped to 16 .. 1048576 (default: NavQuery's, as in nav/nav.h)")
       ->capture_default_str();
+  cmd->add_option("--filter", args->filter_file, "Query filter (JSON): per-material costs and exclusions (below)");
+  cmd->add_option("--links", args->links_file, "Off-mesh links (JSON): jumps, ladders, teleporters (below)");
   cmd->add_option("-o,--output", args->output, "Write the path JSON here instead of stdout");
-  cmd->footer(kPathHelp);
+  cmd->footer(std::string(kPathHelp) + kNavFilterHelp);
   cmd->callback([args, &common] {
     int code = run_path(*args, common);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -393,6 +393,141 @@ static void paths_cross_the_landscape(ldc_world* w) {
   CHECK(s == LDC_NOT_FOUND || (s == LDC_OK && after.status != LDC_PATH_COMPLETE));
 }
 
+/* Two platforms 3 m apart (tops at z = 1, nothing below), platform A crossed by
+ * a strip of material 1 from side to side. */
+static ldc_world* two_platforms(void) {
+  ldc_world_config c;
+  ldc_world_config_default(&c);
+  c.chunk_dims[0] = 4; /* 25.6 x 12.8 x 6.4 m at h = 0.2 */
+  c.chunk_dims[1] = 2;
+  ldc_world* w = NULL;
+  CHECK_STATUS(ldc_world_create(&c, &w), LDC_OK);
+  if (!w) return NULL;
+  ldc_brush b = {0};
+  b.shape = LDC_BRUSH_BOX;
+  b.centre[1] = 4.0, b.centre[2] = 0.6;
+  b.half_extents[0] = 3.9, b.half_extents[1] = 3.9, b.half_extents[2] = 0.4;
+  b.centre[0] = 4.0;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_UNION, NULL), LDC_OK);
+  b.centre[0] = 15.0;
+  CHECK_STATUS(ldc_world_edit(w, &b, LDC_EDIT_UNION, NULL), LDC_OK);
+  ldc_brush strip = {0}; /* paints platform A's top between x = 3.5 and 4.5 */
+  strip.shape = LDC_BRUSH_BOX;
+  strip.centre[0] = 4.0, strip.centre[1] = 4.0, strip.centre[2] = 1.0;
+  strip.half_extents[0] = 0.5, strip.half_extents[1] = 5.0, strip.half_extents[2] = 0.3;
+  strip.material = 1;
+  CHECK_STATUS(ldc_world_edit(w, &strip, LDC_EDIT_PAINT, NULL), LDC_OK);
+  return w;
+}
+
+static ldc_path_status path_status(ldc_world* w, const double from[3], const double to[3]) {
+  ldc_path_info info;
+  const ldc_status s = ldc_world_find_path(w, from, to, NULL, 0, &info);
+  CHECK(s == LDC_OK);
+  return s == LDC_OK ? info.status : LDC_PATH_STATUS_MAX_ENUM;
+}
+
+static void nav_filters_and_links(void) {
+  g_case = "nav_filters_and_links";
+  ldc_world* w = two_platforms();
+  if (!w) return;
+  ldc_nav_config nav;
+  ldc_nav_config_default(&nav);
+  CHECK(nav.material_areas == NULL && nav.material_area_count == 0);
+  const uint8_t areas[2] = {0, 1}; /* material 1 in area 1 */
+  nav.material_areas = areas;
+  nav.material_area_count = 2;
+  CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_OK);
+  const double west[3] = {1.5, 4.0, 1.0}, east[3] = {6.5, 4.0, 1.0}, far[3] = {17.0, 4.0, 1.0};
+  CHECK(path_status(w, west, east) == LDC_PATH_COMPLETE);
+
+  /* A filter that excludes area 1: the strip cuts platform A in two. */
+  ldc_nav_filter filter;
+  ldc_nav_filter_default(&filter);
+  CHECK(filter.include_flags == 0xFFFF && filter.exclude_flags == 0 && filter.area_cost_count == 0);
+  const uint16_t flags[2] = {1, 2};
+  filter.area_flags = flags;
+  filter.area_flag_count = 2;
+  filter.exclude_flags = 2;
+  CHECK_STATUS(ldc_world_set_nav_filter(w, &filter), LDC_OK);
+  CHECK(path_status(w, west, east) != LDC_PATH_COMPLETE);
+  CHECK_STATUS(ldc_world_set_nav_filter(w, NULL), LDC_OK); /* back to the default */
+  CHECK(path_status(w, west, east) == LDC_PATH_COMPLETE);
+  /* Bad filters are refused by field, and change nothing. */
+  const double costs[2] = {1.0, 0.0};
+  filter.area_costs = costs;
+  filter.area_cost_count = 2;
+  CHECK_STATUS(ldc_world_set_nav_filter(w, &filter), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "area_costs[1]") != NULL);
+  filter.area_cost_count = 65;
+  CHECK_STATUS(ldc_world_set_nav_filter(w, &filter), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "area_cost_count") != NULL);
+  filter.area_cost_count = 2;
+  filter.area_costs = NULL;
+  CHECK_STATUS(ldc_world_set_nav_filter(w, &filter), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "area_costs is NULL") != NULL);
+  CHECK_STATUS(ldc_world_set_nav_filter(NULL, NULL), LDC_INVALID_ARGUMENT);
+  CHECK(path_status(w, west, east) == LDC_PATH_COMPLETE);
+
+  /* A link joins the platforms; removing it splits them again. */
+  CHECK(path_status(w, west, far) == LDC_PATH_UNREACHABLE);
+  ldc_nav_link link;
+  ldc_nav_link_default(&link);
+  CHECK(link.bidirectional == 1 && link.cost < 0.0 && link.flags == 1 && link.radius == 1.0);
+  link.a[0] = 7.0, link.a[1] = 4.0, link.a[2] = 1.0;
+  link.b[0] = 12.0, link.b[1] = 4.0, link.b[2] = 1.0;
+  uint32_t id = 99;
+  CHECK_STATUS(ldc_world_add_nav_link(w, &link, &id), LDC_OK);
+  ldc_path_info info;
+  CHECK_STATUS(ldc_world_find_path(w, west, far, NULL, 0, &info), LDC_OK);
+  CHECK(info.status == LDC_PATH_COMPLETE && info.length > 15.0 && info.length < 16.5);
+  int32_t attached = -1;
+  CHECK_STATUS(ldc_world_nav_link_attached(w, id, &attached), LDC_OK);
+  CHECK(attached == 1);
+  /* Links outlive a rebuild of the navigation data (a new config). */
+  nav.agent_radius = 0.4;
+  CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_OK);
+  CHECK(path_status(w, west, far) == LDC_PATH_COMPLETE);
+  /* A link off every floor is kept but unused. */
+  ldc_nav_link stray = link;
+  stray.b[2] = 6.0;
+  stray.radius = 0.5;
+  uint32_t stray_id = 0;
+  CHECK_STATUS(ldc_world_add_nav_link(w, &stray, &stray_id), LDC_OK);
+  CHECK(stray_id != id);
+  CHECK_STATUS(ldc_world_nav_link_attached(w, stray_id, &attached), LDC_OK);
+  CHECK(attached == 0);
+  CHECK_STATUS(ldc_world_remove_nav_link(w, id), LDC_OK);
+  CHECK(path_status(w, west, far) == LDC_PATH_UNREACHABLE);
+  CHECK_STATUS(ldc_world_remove_nav_link(w, id), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "id") != NULL);
+  CHECK_STATUS(ldc_world_nav_link_attached(w, id, &attached), LDC_INVALID_ARGUMENT);
+  /* Bad links are refused by field. */
+  link.radius = 0.0;
+  CHECK_STATUS(ldc_world_add_nav_link(w, &link, &id), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "link->radius") != NULL);
+  link.radius = 1.0;
+  link.a[1] = NAN;
+  CHECK_STATUS(ldc_world_add_nav_link(w, &link, &id), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "link->a") != NULL);
+  link.a[1] = 4.0;
+  link.bidirectional = 2;
+  CHECK_STATUS(ldc_world_add_nav_link(w, &link, &id), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "bidirectional") != NULL);
+  CHECK_STATUS(ldc_world_add_nav_link(w, NULL, &id), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "link is NULL") != NULL);
+  CHECK(path_status(w, west, far) == LDC_PATH_UNREACHABLE); /* none of them was added */
+  /* Material areas are checked like the rest of the config. */
+  const uint8_t bad_areas[2] = {0, 64};
+  nav.material_areas = bad_areas;
+  CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "material_areas[1]") != NULL);
+  nav.material_areas = NULL;
+  CHECK_STATUS(ldc_world_set_nav_config(w, &nav), LDC_INVALID_ARGUMENT);
+  CHECK(strstr(ldc_last_error(), "material_areas is NULL") != NULL);
+  ldc_world_destroy(w);
+}
+
 static void cascades_voxelize_a_level(ldc_world* w) {
   g_case = "cascades_voxelize_a_level";
   ldc_cascade_config c;
@@ -473,6 +608,7 @@ int main(int argc, char** argv) {
   changed_meshes_are_flagged_dirty(w);
   ray_casts_find_the_ground(w);
   paths_cross_the_landscape(w);
+  nav_filters_and_links();
   cascades_voxelize_a_level(w);
   ldc_world_destroy(w);
   cascades_outliving_their_world_refuse_updates();
