@@ -189,11 +189,11 @@ bool NavSearch::expand_one(const NavData& data, int max_nodes) {
     const uint32_t m = e->reversed ? link.region_a : link.region_b;
     if (nodes.seen(m) && nodes.closed[m]) continue;
     if (!filter.passes_flags(link.link.flags) || !filter.passes(dense_to_region(data, m).area)) continue;
-    const glm::vec3 start(e->reversed ? link.b : link.a), end(e->reversed ? link.a : link.b);
-    const float jump = link.link.cost < 0.0 ? glm::length(end - start)
+    const glm::vec3 take_off(e->reversed ? link.b : link.a), landing(e->reversed ? link.a : link.b);
+    const float jump = link.link.cost < 0.0 ? glm::length(landing - take_off)
                                             : float(link.link.cost / data.lattice.cell_size);
-    const float g = nodes.cost[n] + own_cost * glm::length(start - from) + jump;
-    relax(data, n, m, end, g, kViaLink | uint32_t(e - data.link_exits.begin()), max_nodes);
+    const float g = nodes.cost[n] + own_cost * glm::length(take_off - from) + jump;
+    relax(data, n, m, landing, g, kViaLink | uint32_t(e - data.link_exits.begin()), max_nodes);
   }
   return true;
 }

@@ -13,12 +13,6 @@ namespace detail {
 
 namespace {
 
-// Union-find over component ids.
-uint32_t find_root(std::vector<uint32_t>& parent, uint32_t c) {
-  while (parent[c] != c) c = parent[c] = parent[parent[c]];
-  return c;
-}
-
 bool snap_end(const NavData& data, const glm::dvec3& world, double radius, uint32_t* region,
               glm::dvec3* at) {
   const glm::dvec3 reach(radius / data.lattice.cell_size);
@@ -32,31 +26,36 @@ bool snap_end(const NavData& data, const glm::dvec3& world, double radius, uint3
 
 }  // namespace
 
+// Snaps link slot k's ends and, when both land, adds its exits (in order)
+// and joins the islands of its ends' components.
+void attach_one(NavData& data, uint32_t k) {
+  NavLinkSlot& s = data.links[k];
+  s.attached = snap_end(data, s.link.a, s.link.radius, &s.region_a, &s.a) &&
+               snap_end(data, s.link.b, s.link.radius, &s.region_b, &s.b);
+  if (!s.attached) return;
+  auto add_exit = [&](const LinkExit& e) {
+    data.link_exits.insert(std::upper_bound(data.link_exits.begin(), data.link_exits.end(), e), e);
+  };
+  add_exit({s.region_a, k, false});
+  if (s.link.bidirectional) add_exit({s.region_b, k, true});
+  const uint32_t ia = data.island(dense_to_region(data, s.region_a).component);
+  const uint32_t ib = data.island(dense_to_region(data, s.region_b).component);
+  if (ia == ib) return;
+  for (uint32_t& island : data.island_of_component) {
+    if (island == std::max(ia, ib)) island = std::min(ia, ib);
+  }
+}
+
 void attach_links(NavData& data) {
   data.link_exits.clear();
-  std::vector<uint32_t> parent(data.component_count);
-  std::iota(parent.begin(), parent.end(), 0u);
-  for (uint32_t k = 0; k < data.links.size(); ++k) {
-    NavLinkSlot& s = data.links[k];
-    s.attached = snap_end(data, s.link.a, s.link.radius, &s.region_a, &s.a) &&
-                 snap_end(data, s.link.b, s.link.radius, &s.region_b, &s.b);
-    if (!s.attached) continue;
-    data.link_exits.push_back({s.region_a, k, false});
-    if (s.link.bidirectional) data.link_exits.push_back({s.region_b, k, true});
-    // One-way links join islands too: the island check only rules out goals
-    // no link can reach; A* decides the rest.
-    const uint32_t ca = find_root(parent, dense_to_region(data, s.region_a).component);
-    const uint32_t cb = find_root(parent, dense_to_region(data, s.region_b).component);
-    parent[std::max(ca, cb)] = std::min(ca, cb);
-  }
-  std::stable_sort(data.link_exits.begin(), data.link_exits.end());
   data.island_of_component.resize(data.component_count);
-  for (uint32_t c = 0; c < data.component_count; ++c) data.island_of_component[c] = find_root(parent, c);
+  std::iota(data.island_of_component.begin(), data.island_of_component.end(), 0u);
+  for (uint32_t k = 0; k < data.links.size(); ++k) attach_one(data, k);
 }
 
 }  // namespace detail
 
-Result<uint32_t> NavMesh::add_link(const NavLink& link) {
+Status check_nav_link(const NavLink& link) {
   if (!detail::is_finite(link.a) || !detail::is_finite(link.b)) {
     return Status(ErrorCode::kInvalidArgument, "NavLink ends " + detail::vec_text(link.a) + " and " +
                                                    detail::vec_text(link.b) + " must be finite");
@@ -68,12 +67,19 @@ Result<uint32_t> NavMesh::add_link(const NavLink& link) {
     return Status(ErrorCode::kInvalidArgument,
                   "NavLink.radius " + std::to_string(link.radius) + " must be in (0, 100] m");
   }
+  return {};
+}
+
+Result<uint32_t> NavMesh::add_link(const NavLink& link) {
+  if (Status s = check_nav_link(link); !s.ok()) return s;
   detail::NavData& data = *data_;
   detail::NavLinkSlot slot;
   slot.id = data.next_link_id++;
   slot.link = link;
   data.links.push_back(slot);
-  detail::attach_links(data);
+  // Only the new link is snapped: adding n links costs n snaps, not n^2.
+  if (data.island_of_component.size() != data.component_count) detail::attach_links(data);
+  else detail::attach_one(data, uint32_t(data.links.size() - 1));
   return slot.id;
 }
 

@@ -120,6 +120,9 @@ struct NavLink {
   double radius = 1.0;  // [Units: m] [Limit: > 0, <= 100]
 };
 
+// An error naming the bad NavLink field, or ok (what add_link checks first).
+Status check_nav_link(const NavLink& link);
+
 class NavMesh {
  public:
   // Builds from the whole world; parallel over tiles (TBB). The config is

@@ -183,5 +183,7 @@ void relabel(NavData& data);
 // Snaps every link's ends to floors and rebuilds link_exits and the islands
 // (nav/links.cpp); after every relabel and every link change.
 void attach_links(NavData& data);
+// The same for one newly added link slot k, leaving the others as they are.
+void attach_one(NavData& data, uint32_t k);
 
 }  // namespace ldc::detail
