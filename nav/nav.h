@@ -7,7 +7,9 @@
 // exit point of a vertical ray is the top of a solid span, a floor. A floor is
 // walkable when its stored normal is within max_slope of up and the free
 // height above it (to the next span, or the top of the world) is at least
-// agent_height. Two floors in side-by-side columns are linked when the step
+// agent_height; a riser (a normal within 10 degrees of horizontal, where the
+// ray caught a step's edge) is walkable when it is linked to a walkable
+// floor. Two floors in side-by-side columns are linked when the step
 // between them is at most max_climb and the gap between the higher floor and
 // the lower ceiling still holds the agent. Walkable floors within
 // agent_radius of an unlinked side (a wall, a drop, the world's edge) are
@@ -69,8 +71,9 @@ struct NavConfig {
   // the same column (a kerb or a stair nosing), is walkable.
   bool filter_low_hanging_obstacles = true;
   // A floor with a drop deeper than max_climb on one of its four sides (a
-  // ledge; the world's edge counts) is not walkable, even when agent_radius
-  // is 0 (with a radius, erosion removes it anyway).
+  // ledge; the world's edge counts) is not walkable. Applied when the
+  // agent's radius rounds to 0 cells: with a radius, erosion already keeps
+  // the agent that far from the ledge.
   bool filter_ledge_spans = true;
   // A floor with less than agent_height free above it is not walkable. Off:
   // such floors (and the links between them) are kept, e.g. for an agent

@@ -147,7 +147,9 @@ void extract_tile(const NavData& data, const World& world, NavTile& tile) {
         NavFloor f;
         f.height = float(depth);
         f.ceiling = std::numeric_limits<float>::infinity();
-        f.steep_normal = decode_normal(p.normal)[data.up] < data.min_normal_up;
+        const float normal_up = decode_normal(p.normal)[data.up];
+        f.steep_normal = normal_up < data.min_normal_up;
+        f.riser = normal_up < kRiserNormalUp;
         f.area = p.material < data.config.material_areas.size() ? data.config.material_areas[p.material] : 0;
         tile.floors.push_back(f);
         open_floor = true;
@@ -188,14 +190,17 @@ uint8_t best_link(const NavData& data, const NavFloor& f, std::span<const NavFlo
   return best;
 }
 
-// Walkable when the stored normal is, or when a linked neighbour's is: the
-// column stands for an h x h square, and like a navmesh cell (which takes
-// the flattest triangle within max_climb of its top) it is walkable when
-// walkable ground touches it. Creases and small steps one or two cells wide
-// whose point normals are steep are stepped over; a steep ramp or cliff
-// stays closed beyond its first cell.
+// Walkable when the stored normal is within max_slope. A riser (a normal
+// within 10 degrees of horizontal: the ray caught a kerb face, a step's
+// riser or a wall top's edge, which have no floor area of their own) is
+// walkable when a linked neighbour is: it is the edge of that neighbour's
+// step. Ground sloped beyond max_slope is not walkable at all, not even
+// beside flat ground: measured against analytic terrains
+// (bench/nav_truth.cpp), letting it in moved every slope boundary a cell
+// into the steep ground and bridged creases steeper than max_slope.
 bool slope_walkable(const NavFloor& f, const std::array<const NavFloor*, 4>& side) {
   if (!f.steep_normal) return true;
+  if (!f.riser) return false;
   for (const NavFloor* g : side) {
     if (g && !g->steep_normal) return true;
   }
@@ -245,8 +250,11 @@ void link_tile(const NavData& data, NavTile& tile) {
           f.link[d] = mutual ? j : kNoLink;
           if (mutual) side[size_t(d)] = &col[j];
         }
-        f.walkable = slope_walkable(f, side) &&
-                     !(data.config.filter_ledge_spans && has_ledge(data, f, base + glm::ivec2(lu, lv)));
+        // With an agent radius, a ledge's rim is an unlinked side and erosion
+        // measures the radius from it; filtering the rim as well would erode
+        // a cell further than the radius (bench/nav_truth.cpp measured it).
+        const bool ledge_filter = data.config.filter_ledge_spans && data.erode_cells == 0;
+        f.walkable = slope_walkable(f, side) && !(ledge_filter && has_ledge(data, f, base + glm::ivec2(lu, lv)));
       }
     }
   }

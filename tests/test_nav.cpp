@@ -292,11 +292,11 @@ TEST(Nav, LowHangingFilterLiftsASteepFloorJustAboveAWalkableOne) {
   no_lift.filter_low_hanging_obstacles = false;
   const size_t with = nav_of(world, config).stats().walkable;
   const size_t without = nav_of(world, no_lift).stats().walkable;
-  // The wedge's columns x = 3.2 and 3.4 (0.45 and 0.79 m above the ground)
-  // are lifted; x = 3.6 (1.14 m up) then walks by its lifted neighbour's
-  // normal (slope_walkable); on the rows y = 2.2 .. 7.8.
-  EXPECT_GT(with, without);
-  EXPECT_LE(with - without, size_t(3 * 29));
+  // Lifted: the wedge's columns x = 3.0 (on its vertical face, 0.1 m up),
+  // 3.2 and 3.4 (0.45 and 0.79 m up), not 3.6 (1.14 m: beyond max_climb);
+  // on 30 rows (y = 2.0 .. 8.0, the end faces counted once by the symbolic
+  // perturbation). A 60 degree floor is no riser: nothing else lifts it.
+  EXPECT_EQ(with - without, size_t(3 * 30));
 }
 
 TEST(Nav, ALevelWithNoWalkableFloorSaysSo) {

@@ -16,6 +16,7 @@
 namespace ldc::detail {
 
 inline constexpr uint8_t kNoLink = 0xFF;
+inline constexpr float kRiserNormalUp = 0.17364818f;  // sin(10 degrees)
 inline constexpr uint16_t kNoRegion = 0xFFFF;       // not walkable, or eroded away
 inline constexpr uint16_t kUnassigned = 0xFFFE;     // kept by erosion, not yet in a rectangle
 inline constexpr int kMaxLevels = 254;  // floors per column kept (link indices are bytes)
@@ -38,6 +39,7 @@ struct NavFloor {
   float ceiling = 0.0f;  // depth of the next solid above, or +inf
   uint8_t link[4] = {kNoLink, kNoLink, kNoLink, kNoLink};  // floor index in the neighbour column (both ways)
   bool steep_normal = false;  // the stored normal is steeper than max_slope
+  bool riser = false;         // the stored normal is within 10 degrees of horizontal
   bool walkable = false;      // slope walkable (its normal or a linked neighbour's)
   uint16_t region = kNoRegion;  // rectangle (local to the tile) holding it
   uint8_t area = 0;             // NavConfig::material_areas of its surface's material
