@@ -1,7 +1,8 @@
 // Pathfinding: ldc::nav against Recast/Detour on the same 1,000 start/goal
 // pairs (issue 6). Prints markdown tables: build time, query time (median and
 // p99), agreement on which pairs are reachable, path length ratio, rebuild
-// after a 2 m dig, and the grid A* baseline the region search replaces.
+// after a 2 m dig, and the grid A* baseline the region search replaces; then
+// both against the exact walkable set of analytic terrains (bench/nav_truth.h).
 // Scenes: RecastDemo's nav_test.obj, the landscape, the soup levels of
 // tests/data/levels (issue 20: one-sided floors, single-quad walls, read with
 // BuildConfig kAuto) and any --level FILE.obj (y up) given.
@@ -24,6 +25,7 @@
 #include "ldc/terrain.h"
 #include "meshio/meshio.h"
 #include "nav/nav.h"
+#include "nav_truth.h"
 
 namespace {
 
@@ -391,5 +393,9 @@ int main(int argc, char** argv) {
       "Recast build + addTile of the tile holding the dig (tile 32 cells = 9.6 m), from the "
       "re-contoured edited world's triangles near that tile.\n",
       args.quick ? "200" : "1,000");
+  // Who is right: both against the exact walkable set of analytic terrains (issue 20 item 5).
+  ldc::bench::NavTruthOptions truth;
+  truth.pairs = args.quick ? 200 : 1000;
+  ldc::bench::run_nav_truth(truth);
   return 0;
 }
