@@ -7,9 +7,11 @@
 // exit point of a vertical ray is the top of a solid span, a floor. A floor is
 // walkable when its stored normal is within max_slope of up and the free
 // height above it (to the next span, or the top of the world) is at least
-// agent_height; a riser (a normal within 10 degrees of horizontal, where the
-// ray caught a step's edge) is walkable when it is linked to a walkable
-// floor. Two floors in side-by-side columns are linked when the step
+// agent_height; a steeper normal is walkable where the height steps to the
+// neighbouring columns keep the ground within max_slope over a cell (ripples
+// finer than a cell do not block), and a riser (a normal within 10 degrees
+// of horizontal, where the ray caught a step's edge) where it is linked to a
+// floor with a walkable normal. Two floors in side-by-side columns are linked when the step
 // between them is at most max_climb and the gap between the higher floor and
 // the lower ceiling still holds the agent. Walkable floors within
 // agent_radius of an unlinked side (a wall, a drop, the world's edge) are

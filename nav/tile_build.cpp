@@ -65,6 +65,8 @@ void setup_nav_data(NavData& data, const World& world, const NavConfig& config) 
   data.climb_cells = float(config.max_climb / h);
   data.height_cells = float(config.agent_height / h);
   data.min_normal_up = float(std::cos(config.max_slope_degrees * M_PI / 180.0));
+  const double max_gradient = std::tan(config.max_slope_degrees * M_PI / 180.0);
+  data.max_gradient_sq = float(max_gradient * max_gradient);
   data.erode_cells = int(std::ceil(config.agent_radius / h - 1e-9));
   data.tiles.assign(size_t(data.tile_dims.x) * size_t(data.tile_dims.y), NavTile{});
   for (int y = 0; y < data.tile_dims.y; ++y) {
@@ -190,21 +192,34 @@ uint8_t best_link(const NavData& data, const NavFloor& f, std::span<const NavFlo
   return best;
 }
 
-// Walkable when the stored normal is within max_slope. A riser (a normal
-// within 10 degrees of horizontal: the ray caught a kerb face, a step's
-// riser or a wall top's edge, which have no floor area of their own) is
-// walkable when a linked neighbour is: it is the edge of that neighbour's
-// step. Ground sloped beyond max_slope is not walkable at all, not even
-// beside flat ground: measured against analytic terrains
-// (bench/nav_truth.cpp), letting it in moved every slope boundary a cell
-// into the steep ground and bridged creases steeper than max_slope.
-bool slope_walkable(const NavFloor& f, const std::array<const NavFloor*, 4>& side) {
+// Walkable when the stored normal is within max_slope. A steeper normal is
+// only a point of the surface: the floor is still walkable when the ground
+// is within max_slope at the scale of a cell, i.e. the height steps to the
+// linked neighbours (the larger one on each axis, so a V-groove's bottom is
+// as steep as its walls) make a gradient within tan(max_slope); ripples
+// finer than a cell are walked over, a slope or a crease steeper than
+// max_slope over a cell is not. A riser (a normal within 10 degrees of
+// horizontal: the ray caught a kerb face, a step's riser or a wall top's
+// edge, which have no floor area of their own) is walkable when a linked
+// neighbour's normal is: it is the edge of that neighbour's step.
+// (Measured against analytic terrains by bench/nav_truth.cpp.)
+bool slope_walkable(const NavData& data, const NavFloor& f, const std::array<const NavFloor*, 4>& side) {
   if (!f.steep_normal) return true;
-  if (!f.riser) return false;
-  for (const NavFloor* g : side) {
-    if (g && !g->steep_normal) return true;
+  if (f.riser) {
+    for (const NavFloor* g : side) {
+      if (g && !g->steep_normal) return true;
+    }
+    return false;
   }
-  return false;
+  float gradient_sq = 0.0f;
+  for (int axis = 0; axis < 2; ++axis) {
+    float step = 0.0f;
+    for (int d : {axis, axis + 2}) {
+      if (side[size_t(d)]) step = std::max(step, std::fabs(side[size_t(d)]->height - f.height));
+    }
+    gradient_sq += step * step;
+  }
+  return gradient_sq <= data.max_gradient_sq;
 }
 
 // Recast's rcFilterLedgeSpans: a side with no linked floor is a ledge when
@@ -254,7 +269,7 @@ void link_tile(const NavData& data, NavTile& tile) {
         // measures the radius from it; filtering the rim as well would erode
         // a cell further than the radius (bench/nav_truth.cpp measured it).
         const bool ledge_filter = data.config.filter_ledge_spans && data.erode_cells == 0;
-        f.walkable = slope_walkable(f, side) && !(ledge_filter && has_ledge(data, f, base + glm::ivec2(lu, lv)));
+        f.walkable = slope_walkable(data, f, side) && !(ledge_filter && has_ledge(data, f, base + glm::ivec2(lu, lv)));
       }
     }
   }

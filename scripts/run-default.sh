@@ -25,7 +25,7 @@ mkdir -p out
 ./build/tools/ldc info out/default.ldc
 ./build/tools/ldc edit out/default.ldc --script scripts/default-tunnel.json -o out/tunnel.ldc \
   --validate --mesh out/tunnel.glb
-./build/tools/ldc path out/tunnel.ldc --from 47,10,2 --to 24,7.5,2 -o out/path.json
+./build/tools/ldc path out/tunnel.ldc --from 42,10.2,2 --to 24,7.5,2 -o out/path.json
 ./build/tools/ldc render out/tunnel.ldc -o out/tunnel.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
   --width 960 --height 540 --shadows --overlay out/path.json
 ./build/examples/game_loop/game_loop --frames 60 --png out/game_loop

@@ -273,7 +273,7 @@ int main(int argc, char** argv) {
   const double live_ms = ms_since(t);
   Session s(std::move(live).value());
   const std::optional<glm::dvec3> start = ground(s.live.queries(), 24.0, 10.0);
-  const std::optional<glm::dvec3> goal = ground(s.live.queries(), 24.0, 38.0);
+  const std::optional<glm::dvec3> goal = ground(s.live.queries(), 40.5, 25.5);
   if (!start || !goal) return std::fprintf(stderr, "no ground under the agent's start or goal\n"), 1;
   s.agent = *start;
   s.goal = *goal;

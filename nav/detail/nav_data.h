@@ -117,6 +117,7 @@ struct NavData {
   float climb_cells = 0.0f;
   float height_cells = 0.0f;
   float min_normal_up = 0.0f;
+  float max_gradient_sq = 0.0f;        // tan^2(max_slope): cell-scale slope limit
   int erode_cells = 0;                 // ceil(radius / h)
   std::vector<NavTile> tiles;          // tile_dims.x * tile_dims.y, x fastest
   std::vector<uint32_t> dense_tile;    // dense region index -> tile slot
