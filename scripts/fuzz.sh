@@ -4,7 +4,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds=${1:-60}
+# -O1 with line tables: about half the compile time of -O2 -g; reports still name file and line.
 CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
   -DLDC_BUILD_FUZZERS=ON -DLDC_BUILD_TESTS=OFF -DLDC_BUILD_TOOLS=OFF \
   -DLDC_BUILD_CAPI=OFF -DLDC_BUILD_EXAMPLES=OFF -DLDC_INSTALL=OFF >/dev/null
 targets=(fuzz_ldc_load fuzz_mesh_parsers fuzz_edits)

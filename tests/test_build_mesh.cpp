@@ -18,15 +18,7 @@ using test::box_mesh;
 using test::is_valid;
 using test::sphere_mesh;
 
-// A grid whose origin is (0,0,0) and cell size h, so lattice planes sit at multiples of h.
-GridConfig lattice_at_origin(double h) {
-  GridConfig g;
-  g.cell_size = h;
-  g.use_origin = true;
-  g.origin = glm::dvec3(0.0);
-  g.chunk_size = 16;
-  return g;
-}
+using test::lattice_at_origin;
 
 // Number of points on every ray of every axis, summed.
 size_t total_points(const World& w) { return w.stats().points; }

@@ -20,14 +20,7 @@ constexpr double kH = 0.25;  // cell size of every test here
 constexpr double kDepth = kH / 1000;  // stored depths are quantized finer than this
 
 // Lattice planes at multiples of kH.
-GridConfig grid_at_origin() {
-  GridConfig g;
-  g.cell_size = kH;
-  g.use_origin = true;
-  g.origin = glm::dvec3(0.0);
-  g.chunk_size = 16;
-  return g;
-}
+GridConfig grid_at_origin() { return test::lattice_at_origin(kH); }
 
 BuildConfig reading(BuildMode mode, double thickness = 0.0) {
   BuildConfig c;

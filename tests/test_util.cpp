@@ -69,6 +69,15 @@ TriangleMesh sphere_mesh(const glm::dvec3& centre, double radius, int subdivisio
   return m;
 }
 
+GridConfig lattice_at_origin(double h) {
+  GridConfig g;
+  g.cell_size = h;
+  g.use_origin = true;
+  g.origin = glm::dvec3(0.0);
+  g.chunk_size = 16;
+  return g;
+}
+
 void append_mesh(TriangleMesh& a, const TriangleMesh& b) {
   unsigned base = unsigned(a.positions.size());
   a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());

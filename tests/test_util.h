@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "contour/contour.h"
+#include "ldc/build.h"
 #include "ldc/mesh.h"
 #include "ldc/world.h"
 
@@ -23,6 +24,10 @@ TriangleMesh box_mesh(const glm::dvec3& lo, const glm::dvec3& hi);
 
 // Icosphere with `subdivisions` levels (0 = icosahedron), outward.
 TriangleMesh sphere_mesh(const glm::dvec3& centre, double radius, int subdivisions);
+
+// A grid whose origin is (0,0,0) and cell size h, so lattice planes sit at
+// multiples of h; chunks of 16 cells.
+GridConfig lattice_at_origin(double h);
 
 // Appends b's triangles (and positions) to a.
 void append_mesh(TriangleMesh& a, const TriangleMesh& b);
