@@ -87,7 +87,8 @@ MeshComponents mesh_components(const TriangleMesh& mesh, const std::vector<uint3
     sets.join(w[1], w[2]);
   }
   std::vector<uint32_t> component_of_root(welded_count, MeshComponents::kNone);
-  const glm::dvec3 centre = 0.5 * (mesh_bounds(mesh).min + mesh_bounds(mesh).max);
+  const MeshBounds bounds = mesh_bounds(mesh);
+  const glm::dvec3 centre = 0.5 * (bounds.min + bounds.max);  // volumes about it: less cancellation
   for (size_t t = 0; t < n; ++t) {
     if (!usable[t]) continue;
     const uint32_t root = sets.find(welded_id[mesh.triangles[t][0]]);

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
+#include "json_fields.h"
 #include "meshio/meshio.h"
 
 namespace ldc::tool {
@@ -37,74 +38,7 @@ Unknown fields are refused. Example:
 
 namespace {
 
-// The fields of one edit, read with their checks. The first error is kept and
-// later reads return defaults, so a brush reads as straight-line code that is
-// checked once at the end.
-class EditFields {
- public:
-  EditFields(const nlohmann::json& edit, size_t index) : edit_(edit), index_(index) {}
-
-  const Status& error() const { return error_; }
-  void fail(const std::string& field, const std::string& problem) {
-    if (!error_.ok()) return;
-    error_ = Status(ErrorCode::kInvalidArgument, "edit " + std::to_string(index_) + ": field '" + field + "' " + problem);
-  }
-
-  std::string text(const char* name) {
-    const nlohmann::json* v = find(name, true);
-    if (v && !v->is_string()) fail(name, std::string("must be a string, not ") + v->type_name());
-    return v && v->is_string() ? v->get<std::string>() : std::string();
-  }
-  double number(const char* name) {
-    const nlohmann::json* v = find(name, true);
-    return v ? to_number(name, *v) : 0.0;
-  }
-  double number_or(const char* name, double fallback) {
-    const nlohmann::json* v = find(name, false);
-    return v ? to_number(name, *v) : fallback;
-  }
-  uint32_t integer_or(const char* name, uint32_t fallback, uint32_t max) {
-    const nlohmann::json* v = find(name, false);
-    if (!v) return fallback;
-    double d = to_number(name, *v);
-    if (d >= 0.0 && d <= double(max) && std::floor(d) == d) return uint32_t(d);
-    fail(name, "must be a whole number in 0 .. " + std::to_string(max));
-    return fallback;
-  }
-  glm::dvec3 vec3(const char* name) {
-    const nlohmann::json* v = find(name, true);
-    return v ? to_vec3(name, *v) : glm::dvec3(0.0);
-  }
-  glm::dvec3 vec3_or(const char* name, const glm::dvec3& fallback) {
-    const nlohmann::json* v = find(name, false);
-    return v ? to_vec3(name, *v) : fallback;
-  }
-
- private:
-  const nlohmann::json* find(const char* name, bool required) {
-    auto it = edit_.find(name);
-    if (it != edit_.end()) return &*it;
-    if (required) fail(name, "is missing");
-    return nullptr;
-  }
-  double to_number(const char* name, const nlohmann::json& v) {
-    if (!v.is_number()) fail(name, std::string("must be a number, not ") + v.type_name());
-    double d = v.is_number() ? v.get<double>() : 0.0;
-    if (!std::isfinite(d)) fail(name, "must be a finite number");
-    return std::isfinite(d) ? d : 0.0;
-  }
-  glm::dvec3 to_vec3(const char* name, const nlohmann::json& v) {
-    if (!v.is_array() || v.size() != 3) {
-      fail(name, "must be an array of three numbers [x, y, z]");
-      return glm::dvec3(0.0);
-    }
-    return {to_number(name, v[0]), to_number(name, v[1]), to_number(name, v[2])};
-  }
-
-  const nlohmann::json& edit_;
-  size_t index_;
-  Status error_;
-};
+using EditFields = JsonFields<nlohmann::json>;
 
 // Mesh brushes' files, each loaded once however many edits use it.
 class MeshFiles {
@@ -214,15 +148,10 @@ const BrushKind* find_brush_kind(const std::string& name) {
 
 // Refuses fields the brush does not take: a misspelt optional field would
 // otherwise be dropped without a word.
-void refuse_unknown_fields(const nlohmann::json& edit, const BrushKind& kind, EditFields& f) {
-  std::string known = "op, brush, material";
-  for (const std::string& name : kind.fields) known += ", " + name;
-  for (const auto& [name, value] : edit.items()) {
-    bool common = name == "op" || name == "brush" || name == "material";
-    if (!common && std::find(kind.fields.begin(), kind.fields.end(), name) == kind.fields.end()) {
-      f.fail(name, "is not known for brush '" + std::string(kind.name) + "' (fields: " + known + ")");
-    }
-  }
+void refuse_unknown_fields(const BrushKind& kind, EditFields& f) {
+  std::vector<std::string> known = {"op", "brush", "material"};
+  known.insert(known.end(), kind.fields.begin(), kind.fields.end());
+  f.refuse_unknown(known, " for brush '" + std::string(kind.name) + "'");
 }
 
 Result<ScriptEdit> read_edit(const nlohmann::json& edit, size_t index, MeshFiles& files) {
@@ -230,14 +159,14 @@ Result<ScriptEdit> read_edit(const nlohmann::json& edit, size_t index, MeshFiles
     return Status(ErrorCode::kInvalidArgument,
                   "edit " + std::to_string(index) + ": must be an object, not " + edit.type_name());
   }
-  EditFields f(edit, index);
+  EditFields f(edit, "edit " + std::to_string(index));
   std::string op_name = f.text("op"), brush_name = f.text("brush");
   std::optional<EditOp> op = edit_op_from_name(op_name);
   const BrushKind* kind = find_brush_kind(brush_name);
   if (!op) f.fail("op", "is '" + op_name + "', not an op (union, subtract, intersect, paint)");
   if (!kind) f.fail("brush", "is '" + brush_name + "', not a brush (sphere, box, capsule, cylinder, noise, mesh)");
   if (!f.error().ok()) return f.error();
-  refuse_unknown_fields(edit, *kind, f);
+  refuse_unknown_fields(*kind, f);
   auto material = uint16_t(f.integer_or("material", 0, 65535));
   Brush brush = kind->read(f, material, files);
   if (!f.error().ok()) return f.error();

@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common.h"
+#include "json_fields.h"
 
 namespace ldc::tool {
 
@@ -37,85 +38,7 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-// The fields of one JSON object, read with their checks. The first error is
-// kept and later reads return defaults, so reading is straight-line code
-// checked once at the end (as the edit scripts' EditFields).
-class Fields {
- public:
-  Fields(const Json& object, std::string context) : object_(object), context_(std::move(context)) {}
-
-  const Status& error() const { return error_; }
-  void fail(const std::string& field, const std::string& problem) {
-    if (!error_.ok()) return;
-    error_ = Status(ErrorCode::kInvalidArgument, context_ + ": field '" + field + "' " + problem);
-  }
-
-  // Refuses fields not in `known`: a misspelt optional field would otherwise
-  // be dropped without a word.
-  void refuse_unknown(const std::vector<std::string>& known) {
-    std::string list;
-    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
-    for (const auto& [name, value] : object_.items()) {
-      if (std::find(known.begin(), known.end(), name) == known.end()) {
-        fail(name, "is not known (fields: " + list + ")");
-      }
-    }
-  }
-
-  double number_or(const char* name, double fallback) {
-    const Json* v = find(name, false);
-    return v ? to_number(name, *v) : fallback;
-  }
-  uint16_t flags_or(const char* name, uint16_t fallback) {
-    const Json* v = find(name, false);
-    if (!v) return fallback;
-    const double d = to_number(name, *v);
-    if (d >= 0.0 && d <= 65535.0 && std::floor(d) == d) return uint16_t(d);
-    if (error_.ok()) fail(name, "is " + number_text(*v) + ": must be a whole number in 0 .. 65535");
-    return fallback;
-  }
-  bool boolean_or(const char* name, bool fallback) {
-    const Json* v = find(name, false);
-    if (!v) return fallback;
-    if (!v->is_boolean()) {
-      fail(name, std::string("must be true or false, not ") + v->type_name());
-      return fallback;
-    }
-    return v->get<bool>();
-  }
-  glm::dvec3 vec3(const char* name) {
-    const Json* v = find(name, true);
-    if (!v) return glm::dvec3(0.0);
-    if (!v->is_array() || v->size() != 3) {
-      fail(name, "must be an array of three numbers [x, y, z]");
-      return glm::dvec3(0.0);
-    }
-    return {to_number(name, (*v)[0]), to_number(name, (*v)[1]), to_number(name, (*v)[2])};
-  }
-  // The number as the file wrote it, for messages.
-  static std::string number_text(const Json& v) { return v.dump(); }
-
- private:
-  const Json* find(const char* name, bool required) {
-    auto it = object_.find(name);
-    if (it != object_.end()) return &*it;
-    if (required) fail(name, "is missing");
-    return nullptr;
-  }
-  double to_number(const char* name, const Json& v) {
-    if (!v.is_number()) {
-      fail(name, std::string("must be a number, not ") + v.type_name());
-      return 0.0;
-    }
-    const double d = v.get<double>();
-    if (!std::isfinite(d)) fail(name, "must be a finite number");
-    return std::isfinite(d) ? d : 0.0;
-  }
-
-  const Json& object_;
-  std::string context_;
-  Status error_;
-};
+using Fields = JsonFields<Json>;
 
 Status invalid(const std::string& message) { return Status(ErrorCode::kInvalidArgument, message); }
 
@@ -161,8 +84,8 @@ Result<FilterFile> read_filter_file(const std::string& path) {
   file.path = path;
   Fields f(top, path);
   f.refuse_unknown({"materials", "include_flags", "exclude_flags"});
-  file.include_flags = f.flags_or("include_flags", file.include_flags);
-  file.exclude_flags = f.flags_or("exclude_flags", file.exclude_flags);
+  file.include_flags = uint16_t(f.integer_or("include_flags", file.include_flags, 0xFFFF));
+  file.exclude_flags = uint16_t(f.integer_or("exclude_flags", file.exclude_flags, 0xFFFF));
   if (!f.error().ok()) return f.error();
   const auto materials = top.find("materials");
   if (materials == top.end()) return file;
@@ -186,9 +109,9 @@ Result<FilterFile> read_filter_file(const std::string& path) {
     rule.key = key;
     rule.cost = m.number_or("cost", rule.cost);
     if (m.error().ok() && !(rule.cost >= 0.01)) {
-      m.fail("cost", "is " + Fields::number_text(value.at("cost")) + ": must be a finite number >= 0.01");
+      m.fail("cost", "is " + value.at("cost").dump() + ": must be a finite number >= 0.01");
     }
-    rule.flags = m.flags_or("flags", rule.flags);
+    rule.flags = uint16_t(m.integer_or("flags", rule.flags, 0xFFFF));
     rule.exclude = m.boolean_or("exclude", rule.exclude);
     if (!m.error().ok()) return m.error();
     file.materials.push_back(rule);
@@ -282,7 +205,7 @@ Result<LinksFile> read_links_file(const std::string& path) {
     link.b = f.vec3("b");
     link.bidirectional = f.boolean_or("bidirectional", link.bidirectional);
     link.cost = f.number_or("cost", link.cost);
-    link.flags = f.flags_or("flags", link.flags);
+    link.flags = uint16_t(f.integer_or("flags", link.flags, 0xFFFF));
     link.radius = f.number_or("radius", link.radius);
     if (!f.error().ok()) return f.error();
     file.links.push_back(link);
