@@ -62,38 +62,16 @@ Status snap_vertices(const TriangleMesh& mesh, const Lattice& lat, SnappedMesh& 
 
 namespace {
 
-// Edge balance on welded triangles: a mesh is closed when every undirected edge
-// is used as often in one direction as in the other (then the winding number
-// is well defined everywhere). Edges are bucketed by their smaller vertex
-// (a counting sort), so this is linear in the triangle count.
+// Edge balance on welded triangles: a mesh is closed when every undirected
+// edge is used as often in one direction as in the other (then the winding
+// number is well defined everywhere).
 void count_open_edges(const std::vector<std::array<uint32_t, 3>>& tris, size_t vertices,
                       BuildReport& report) {
-  std::vector<uint32_t> first(vertices + 1, 0);
-  for (const auto& t : tris)
-    for (int e = 0; e < 3; ++e)
-      if (t[e] != t[(e + 1) % 3]) ++first[std::min(t[e], t[(e + 1) % 3]) + 1];
-  for (size_t v = 0; v < vertices; ++v) first[v + 1] += first[v];
-  std::vector<std::pair<uint32_t, int>> other(first[vertices]);  // (larger vertex, +-1)
-  std::vector<uint32_t> fill(first.begin(), first.end() - 1);
-  for (const auto& t : tris) {
-    for (int e = 0; e < 3; ++e) {
-      uint32_t a = t[e], b = t[(e + 1) % 3];
-      if (a != b) other[fill[std::min(a, b)]++] = {std::max(a, b), a < b ? 1 : -1};
-    }
-  }
   size_t unbalanced = 0, boundary = 0;
-  for (size_t v = 0; v < vertices; ++v) {
-    auto begin = other.begin() + first[v], end = other.begin() + first[v + 1];
-    std::sort(begin, end);
-    for (auto i = begin; i != end;) {
-      auto j = i;
-      int balance = 0;
-      while (j != end && j->first == i->first) balance += (j++)->second;
-      unbalanced += balance != 0;
-      boundary += (j - i) == 1;
-      i = j;
-    }
-  }
+  for_each_undirected_edge(tris, vertices, [&](uint32_t, uint32_t, int balance, size_t uses) {
+    unbalanced += balance != 0;
+    boundary += uses == 1;
+  });
   report.input_closed = unbalanced == 0;
   report.boundary_edges = boundary;
 }

@@ -4,7 +4,7 @@
 #include <algorithm>
 #include <numeric>
 
-#include <tbb/parallel_sort.h>
+#include "ldc/detail/mesh_raster.h"
 
 namespace ldc::detail {
 namespace {
@@ -38,36 +38,17 @@ bool degenerate(const TriangleMesh& mesh, size_t t, const std::array<uint32_t, 3
 }
 
 // Marks components with an unbalanced edge open and counts edges used once.
-void find_open_edges(const TriangleMesh& mesh, const std::vector<uint32_t>& welded_id,
-                     DisjointSets& sets, const std::vector<uint32_t>& component_of_root,
-                     MeshComponents& out) {
-  struct DirectedEdge {
-    uint64_t key;  // smaller vertex << 32 | larger vertex
-    int8_t sign;
-  };
-  std::vector<DirectedEdge> edges;
-  edges.reserve(mesh.triangles.size() * 3);
+void find_open_edges(const TriangleMesh& mesh, const std::vector<uint32_t>& welded_id, size_t welded_count,
+                     DisjointSets& sets, const std::vector<uint32_t>& component_of_root, MeshComponents& out) {
+  std::vector<std::array<uint32_t, 3>> tris;
+  tris.reserve(mesh.triangles.size());
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    if (out.of_triangle[t] == MeshComponents::kNone) continue;
-    const auto w = welded_triangle(mesh, t, welded_id);
-    for (int e = 0; e < 3; ++e) {
-      const uint32_t a = w[size_t(e)], b = w[size_t((e + 1) % 3)];
-      edges.push_back({uint64_t(std::min(a, b)) << 32 | std::max(a, b), int8_t(a < b ? 1 : -1)});
-    }
+    if (out.of_triangle[t] != MeshComponents::kNone) tris.push_back(welded_triangle(mesh, t, welded_id));
   }
-  tbb::parallel_sort(edges.begin(), edges.end(),
-                     [](const DirectedEdge& x, const DirectedEdge& y) { return x.key < y.key; });
-  for (size_t i = 0; i < edges.size();) {
-    size_t j = i;
-    int balance = 0;
-    while (j < edges.size() && edges[j].key == edges[i].key) balance += edges[j++].sign;
-    out.boundary_edges += (j - i) == 1;
-    if (balance != 0) {
-      const uint32_t root = sets.find(uint32_t(edges[i].key >> 32));
-      out.closed[component_of_root[root]] = 0;
-    }
-    i = j;
-  }
+  for_each_undirected_edge(tris, welded_count, [&](uint32_t a, uint32_t, int balance, size_t uses) {
+    out.boundary_edges += uses == 1;
+    if (balance != 0) out.closed[component_of_root[sets.find(a)]] = 0;
+  });
 }
 
 }  // namespace
@@ -106,7 +87,7 @@ MeshComponents mesh_components(const TriangleMesh& mesh, const std::vector<uint3
     out.volume[c] += glm::dot(a, glm::cross(b, d)) / 6.0;
     out.area[c] += 0.5 * glm::length(glm::cross(b - a, d - a));
   }
-  find_open_edges(mesh, welded_id, sets, component_of_root, out);
+  find_open_edges(mesh, welded_id, welded_count, sets, component_of_root, out);
   return out;
 }
 
