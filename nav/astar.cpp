@@ -178,7 +178,7 @@ bool NavSearch::expand_one(const NavData& data, int max_nodes) {
     const NavPortal& p = tile.portals[r.first_portal + k];
     const uint32_t m = p.to_dense;
     if (nodes.seen(m) && nodes.closed[m]) continue;
-    if (!filter.passes(portal_target(data, p).area)) continue;
+    if (filter_areas && !filter.passes(portal_target(data, p).area)) continue;
     const glm::vec3 at = crossing_point(p, from, glm::vec3(target));
     relax(data, n, m, at, nodes.cost[n] + own_cost * glm::length(at - from), r.first_portal + k, max_nodes);
   }

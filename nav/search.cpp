@@ -166,6 +166,9 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
   s.reset(data.dense_count);
   s.filter = options.filter;
   s.heuristic_scale = heuristic_scale(options.filter);
+  // Areas missing from area_flags have flags 1: a filter that passes flag 1
+  // and lists no flags passes every area.
+  s.filter_areas = !options.filter.area_flags.empty() || !options.filter.passes_flags(1);
   s.start = start->point;
   s.start_region = dense_region(data, *start);
   const uint32_t island = data.island(detail::dense_to_region(data, s.start_region).component);

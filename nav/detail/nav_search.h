@@ -63,6 +63,7 @@ struct NavSearch {
   SearchNodes nodes;
   NavFilter filter;
   float heuristic_scale = 0.999f;  // Detour's H_SCALE times the cheapest cost
+  bool filter_areas = false;       // the filter turns some area away (else no area lookups)
   GridSearchState grid;
   bool active = false;
   bool done = false;
