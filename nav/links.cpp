@@ -77,9 +77,9 @@ Result<uint32_t> NavMesh::add_link(const NavLink& link) {
   slot.id = data.next_link_id++;
   slot.link = link;
   data.links.push_back(slot);
-  // Only the new link is snapped: adding n links costs n snaps, not n^2.
-  if (data.island_of_component.size() != data.component_count) detail::attach_links(data);
-  else detail::attach_one(data, uint32_t(data.links.size() - 1));
+  // Only the new link is snapped (build and update attach the rest): adding
+  // n links costs n snaps, not n^2.
+  detail::attach_one(data, uint32_t(data.links.size() - 1));
   return slot.id;
 }
 
