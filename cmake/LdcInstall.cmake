@@ -2,6 +2,7 @@
 #   P/include/ldc/<module>/*.h          public headers only (no detail/, no internal/)
 #   P/lib/libldc_*.a, P/lib/libldc_c.so* the libraries
 #   P/lib/cmake/ldc/ldcConfig.cmake, ldcConfigVersion.cmake, ldcTargets-<component>.cmake
+#   P/bin/ldc, P/lib/ldc/ldc-vdb.so    the tool and its OpenVDB plugin (loaded for .vdb output only)
 # and `find_package(ldc 0.3 COMPONENTS core contour ...)` then gives the
 # ldc::<component> targets asked for and finds only what those need (see
 # ldcConfig.cmake.in); without COMPONENTS every component that was built.
@@ -76,4 +77,8 @@ install(FILES ${CMAKE_CURRENT_BINARY_DIR}/ldcConfig.cmake ${CMAKE_CURRENT_BINARY
         DESTINATION ${LDC_INSTALL_CMAKEDIR} COMPONENT dev)
 if(TARGET ldc_tool)
   install(TARGETS ldc_tool RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT tools)
+  # The OpenVDB plugin that `ldc voxelize -o X.vdb` loads, where the tool
+  # looks for it: <libdir>/ldc (its LDC_INSTALL_DIR, voxelize/CMakeLists.txt).
+  get_target_property(ldc_vdb_plugin_dir ldc_vdb_plugin LDC_INSTALL_DIR)
+  install(TARGETS ldc_vdb_plugin LIBRARY DESTINATION ${ldc_vdb_plugin_dir} COMPONENT tools)
 endif()

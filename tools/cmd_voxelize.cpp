@@ -1,14 +1,35 @@
 // ldc voxelize: solid occupancy and the six-face G-buffer of a world -> .vdb, or raw arrays + JSON header.
+#include <dlfcn.h>
+
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <string>
+#include <system_error>
+#include <vector>
 
 #include "common.h"
 #include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
-#include "voxelize/vdb.h"
 #include "voxelize/voxelize.h"
+
+#if !defined(LDC_VDB_PLUGIN_FILE) || !defined(LDC_VDB_PLUGIN_INSTALL_REL) || !defined(LDC_VDB_PLUGIN_ABI)
+#error "the OpenVDB plugin's file name, install path and ABI come from tools/CMakeLists.txt"
+#endif
+
+// The entry points of the OpenVDB plugin (voxelize/vdb_plugin.cpp, which
+// documents them): change both sides together and bump LDC_VDB_PLUGIN_ABI.
+extern "C" {
+struct LdcVdbGrid {
+  const ldc::VoxelGrid* grid;
+  const char* suffix;
+};
+using LdcVdbErrorFn = void (*)(void* user, const char* message);
+using LdcVdbAbiFn = int (*)();
+using LdcVdbWriteFn = int (*)(const LdcVdbGrid* grids, size_t count, size_t grid_bytes, const char* path,
+                              const char* source, LdcVdbErrorFn on_error, void* user);
+}
 
 namespace ldc::tool {
 namespace {
@@ -49,6 +70,112 @@ Result<int> ray_axis(const VoxelizeArgs& a) {
   return Status(ErrorCode::kInvalidArgument, "--ray-axis '" + a.axis + "': use x, y or z");
 }
 
+// --- The OpenVDB plugin ----------------------------------------------------
+// OpenVDB is not linked into the tool: relocating libopenvdb cost every
+// command ~60 ms at start-up. It is dlopen()ed here, only for a .vdb output.
+
+// The loaded plugin (a struct: GCC's -Wshadow flags Result<> of a bare
+// function pointer, whose constructor argument "value" may be called).
+struct VdbPlugin {
+  LdcVdbWriteFn write = nullptr;
+};
+
+std::filesystem::path exe_dir() {
+  std::error_code ec;
+  return std::filesystem::read_symlink("/proc/self/exe", ec).parent_path();
+}
+
+// Beside the tool (the build tree), then the install layout (<libdir>/ldc).
+std::vector<std::string> vdb_plugin_paths() {
+  const std::filesystem::path dir = exe_dir();
+  return {(dir / LDC_VDB_PLUGIN_FILE).string(),
+          (dir / LDC_VDB_PLUGIN_INSTALL_REL / LDC_VDB_PLUGIN_FILE).lexically_normal().string()};
+}
+
+// dlerror() text without the path it may begin with (the caller names it).
+std::string dl_reason(const std::string& path) {
+  const char* e = dlerror();
+  std::string reason = e != nullptr ? e : "unknown error";
+  if (reason.starts_with(path + ": ")) reason.erase(0, path.size() + 2);
+  return reason;
+}
+
+// Loads one candidate; on failure, why (without the path).
+Result<VdbPlugin> open_vdb_plugin(const std::string& path) {
+  // RTLD_LOCAL: OpenVDB's symbols stay out of the tool's namespace. The
+  // handle is never closed: OpenVDB and TBB keep state until exit.
+  void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+  if (handle == nullptr) return Status(ErrorCode::kIoError, dl_reason(path));
+  auto abi = reinterpret_cast<LdcVdbAbiFn>(dlsym(handle, "ldc_vdb_plugin_abi"));
+  auto write = reinterpret_cast<LdcVdbWriteFn>(dlsym(handle, "ldc_vdb_plugin_write"));
+  const int plugin_abi = abi != nullptr ? abi() : -1;
+  std::string why;
+  if (abi == nullptr || write == nullptr) {
+    why = "not an ldc OpenVDB plugin (no ldc_vdb_plugin_abi / ldc_vdb_plugin_write)";
+  } else if (plugin_abi != LDC_VDB_PLUGIN_ABI) {
+    why = "plugin ABI " + std::to_string(plugin_abi) + ", this tool needs " + std::to_string(LDC_VDB_PLUGIN_ABI) +
+          " (a stale plugin from another ldc build)";
+  }
+  if (why.empty()) return VdbPlugin{write};
+  dlclose(handle);
+  return Status(ErrorCode::kUnsupported, why);
+}
+
+Result<VdbPlugin> load_vdb_plugin() {
+  std::string tried;
+  for (const std::string& path : vdb_plugin_paths()) {
+    Result<VdbPlugin> plugin = open_vdb_plugin(path);
+    if (plugin.ok()) return plugin;
+    tried += (tried.empty() ? "" : "; ") + path + ": " + plugin.status().message();
+  }
+  return Status(ErrorCode::kUnsupported, std::string("a .vdb output needs the OpenVDB plugin " LDC_VDB_PLUGIN_FILE
+                                                     ", which did not load (tried ") +
+                                             tried + "). Write .json or .raw instead: they need no OpenVDB");
+}
+
+// Loaded once, on the first .vdb output.
+const Result<VdbPlugin>& vdb_plugin() {
+  static const Result<VdbPlugin> plugin = load_vdb_plugin();
+  return plugin;
+}
+
+void keep_message(void* user, const char* message) noexcept {
+  try {
+    *static_cast<std::string*>(user) = message;
+  } catch (...) {  // out of memory: the caller's fallback message stands
+  }
+}
+
+// ldc::save_vdb through the plugin: the same files and the same messages.
+Status write_vdb(const std::vector<LdcVdbGrid>& grids, const std::string& path, const std::string& source) {
+  const Result<VdbPlugin>& plugin = vdb_plugin();
+  if (!plugin.ok()) return plugin.status();
+  std::string message = path + ": the OpenVDB plugin failed without a message";
+  const int code = plugin.value().write(grids.data(), grids.size(), sizeof(VoxelGrid), path.c_str(),
+                                        source.c_str(), keep_message, &message);
+  return code == 0 ? Status() : Status(static_cast<ErrorCode>(code), message);
+}
+
+Status write_vdb(const VoxelGrid& grid, const std::string& path, const std::string& source) {
+  const LdcVdbGrid one{&grid, ""};
+  return write_vdb(std::vector<LdcVdbGrid>{one}, path, source);
+}
+
+// Every valid level as occupancy_L<k>, normal_L<k>, albedo_L<k> (as
+// ldc::save_vdb(const Cascades&, ...)).
+Status write_vdb(const Cascades& cascades, const std::string& path, const std::string& source) {
+  std::vector<VoxelGrid> levels;
+  std::vector<std::string> names;
+  for (int k = 0; k < cascades.levels(); ++k) {
+    if (!cascades.level_valid(k)) continue;
+    levels.push_back(cascades.level_grid(k));
+    names.push_back("_L" + std::to_string(k));
+  }
+  std::vector<LdcVdbGrid> grids;
+  for (size_t i = 0; i < levels.size(); ++i) grids.push_back({&levels[i], names[i].c_str()});
+  return write_vdb(grids, path, source);
+}
+
 nlohmann::json box_json(const VoxelBox& b) {
   return {{"lo", {b.lo.x, b.lo.y, b.lo.z}}, {"dims", {b.dims.x, b.dims.y, b.dims.z}}};
 }
@@ -59,7 +186,7 @@ Result<nlohmann::json> run_dense(const VoxelizeArgs& a, const World& world, int 
   VoxelStats stats;
   Result<VoxelGrid> g = voxelize(world, VoxelConfig{.voxel_size = a.voxel_size, .axis = axis}, opt, ctx, &stats);
   if (!g.ok()) return g.status();
-  Status s = format == Format::kVdb ? save_vdb(g.value(), a.output, a.world) : save_raw(g.value(), a.output);
+  Status s = format == Format::kVdb ? write_vdb(g.value(), a.output, a.world) : save_raw(g.value(), a.output);
   if (!s.ok()) return s;
   return nlohmann::json{{"mode", "dense"},
                         {"voxel_size", a.voxel_size},
@@ -94,7 +221,7 @@ Result<nlohmann::json> run_cascades(const VoxelizeArgs& a, const World& world, i
   Status s = c.value().update_all(world, camera, ctx);
   if (!s.ok()) return s;
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  s = format == Format::kVdb ? save_vdb(c.value(), a.output, a.world) : save_raw(c.value(), a.output);
+  s = format == Format::kVdb ? write_vdb(c.value(), a.output, a.world) : save_raw(c.value(), a.output);
   if (!s.ok()) return s;
   nlohmann::json levels = nlohmann::json::array();
   for (int k = 0; k < c.value().levels(); ++k) {
@@ -138,6 +265,8 @@ int run_voxelize(const VoxelizeArgs& a, const CommonOptions& common) {
   if (!axis.ok()) return fail("voxelize", axis.status());
   if (a.cascades < 0) return fail("voxelize", "--cascades " + std::to_string(a.cascades) + ": must be >= 0 (0: one dense grid)");
   if (a.cascades == 0 && !a.camera.empty()) return fail("voxelize", "--camera needs --cascades K");
+  // A missing plugin is found before the (maybe long) voxelization.
+  if (format.value() == Format::kVdb && !vdb_plugin().ok()) return fail("voxelize", vdb_plugin().status().message());
   Result<World> world = load_world(a.world);
   if (!world.ok()) return fail("voxelize", world.status());
   ProgressBar bar(!common.quiet);

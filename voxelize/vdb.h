@@ -1,5 +1,6 @@
 // OpenVDB export of voxel grids (library ldc::voxelize_vdb, linked by the
-// tool, the tests and the benchmarks only). OpenVDB's headers stay in vdb.cpp.
+// tests and the benchmarks; the tool loads it through the plugin ldc-vdb.so,
+// vdb_plugin.cpp, only to write a .vdb file). OpenVDB's headers stay in vdb.cpp.
 //
 // Each grid becomes three OpenVDB grids that DCC tools (Houdini, Blender)
 // open: "occupancy" (FloatGrid, fog volume: the volume fraction, active where

@@ -1,7 +1,8 @@
 # Installs the build into a scratch prefix, checks that the installed public
 # headers include nothing from CGAL, OpenVDB, Embree, a detail/ folder or internal/
 # folders, then configures, builds and runs tests/install/consumer against
-# the package with find_package(ldc). Run by ctest (label install):
+# the package with find_package(ldc), and runs the installed tool (its .vdb
+# export through the OpenVDB plugin). Run by ctest (label install):
 #   cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -P run_install_test.cmake
 cmake_policy(VERSION 3.20)
 foreach(var BUILD_DIR CONSUMER_DIR WORK_DIR)
@@ -88,3 +89,36 @@ foreach(component core contour meshio csg nav voxelize live render c)
   run(${CMAKE_COMMAND} --build ${component_build})
   run(${component_build}/component)
 endforeach()
+
+# The installed tool: it maps no OpenVDB at start-up (LD_DEBUG=libs lists what the loader maps),
+# and `voxelize -o X.vdb` loads its plugin from the prefix (<libdir>/ldc/ldc-vdb.so, found from
+# <prefix>/bin) and writes the file.
+set(tool ${prefix}/bin/ldc)
+if(NOT EXISTS ${tool})
+  message("no tool installed at ${tool} (LDC_BUILD_TOOLS off?): the installed tool is not checked")
+  return()
+endif()
+function(run_tool out_var)
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env LD_DEBUG=libs ${tool} ${ARGN}
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "failed (${rc}): ${tool} ${ARGN}\n${out}\n${err}")
+  endif()
+  set(${out_var} "${err}" PARENT_SCOPE)
+endfunction()
+run_tool(loader --version)
+if(NOT loader MATCHES "initialize program: " OR loader MATCHES "libopenvdb")
+  message(FATAL_ERROR "${tool} --version maps libopenvdb (or LD_DEBUG was ignored):\n${loader}")
+endif()
+set(tool_dir ${WORK_DIR}/tool)
+file(MAKE_DIRECTORY ${tool_dir})
+run_tool(loader -q terrain --size 12,12 --cell-size 0.4 -o ${tool_dir}/world.ldc)
+run_tool(loader -q voxelize ${tool_dir}/world.ldc --voxel-size 0.4 -o ${tool_dir}/world.vdb)
+if(NOT EXISTS ${tool_dir}/world.vdb)
+  message(FATAL_ERROR "the installed tool did not write ${tool_dir}/world.vdb")
+endif()
+string(REGEX REPLACE "([][+.*?()^$|\\])" "\\\\\\1" prefix_regex "${prefix}")
+if(NOT loader MATCHES "calling init: ${prefix_regex}/[^\n]*/ldc/ldc-vdb\\.so\n")
+  message(FATAL_ERROR "the installed tool did not load its plugin from ${prefix}:\n${loader}")
+endif()
+message("the installed tool maps no OpenVDB at start-up and writes .vdb through ${prefix}/.../ldc/ldc-vdb.so")
