@@ -12,24 +12,12 @@
 #include "common.h"
 #include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
+#include "voxelize/vdb_plugin.h"
 #include "voxelize/voxelize.h"
 
 #if !defined(LDC_VDB_PLUGIN_FILE) || !defined(LDC_VDB_PLUGIN_INSTALL_REL) || !defined(LDC_VDB_PLUGIN_ABI)
 #error "the OpenVDB plugin's file name, install path and ABI come from tools/CMakeLists.txt"
 #endif
-
-// The entry points of the OpenVDB plugin (voxelize/vdb_plugin.cpp, which
-// documents them): change both sides together and bump LDC_VDB_PLUGIN_ABI.
-extern "C" {
-struct LdcVdbGrid {
-  const ldc::VoxelGrid* grid;
-  const char* suffix;
-};
-using LdcVdbErrorFn = void (*)(void* user, const char* message);
-using LdcVdbAbiFn = int (*)();
-using LdcVdbWriteFn = int (*)(const LdcVdbGrid* grids, size_t count, size_t grid_bytes, const char* path,
-                              const char* source, LdcVdbErrorFn on_error, void* user);
-}
 
 namespace ldc::tool {
 namespace {

@@ -15,21 +15,13 @@
 #include <vector>
 
 #include "voxelize/vdb.h"
+#include "voxelize/vdb_plugin.h"
 
 #ifndef LDC_VDB_PLUGIN_ABI
 #error "LDC_VDB_PLUGIN_ABI must be defined (voxelize/CMakeLists.txt)"
 #endif
 
 extern "C" {
-
-// One grid set: the grid and the suffix of its OpenVDB grid names ("_L0").
-struct LdcVdbGrid {
-  const ldc::VoxelGrid* grid;
-  const char* suffix;
-};
-
-// Receives the error message (valid during the call only).
-using LdcVdbErrorFn = void (*)(void* user, const char* message);
 
 // The ABI number this plugin was built with; the tool checks it on load.
 __attribute__((visibility("default"))) int ldc_vdb_plugin_abi() { return LDC_VDB_PLUGIN_ABI; }
