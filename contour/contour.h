@@ -406,4 +406,39 @@ Status check_simplify_options(const SimplifyOptions& options);
 // "simplify" on ctx.
 Result<SimplifyStats> simplify_mesh(ContourMesh& mesh, const SimplifyOptions& options, Context* ctx = nullptr);
 
+// --- Untangling the assembled mesh ------------------------------------------------
+//
+// ContourConfig::untangle clears most self-intersections while contouring
+// (one local round at the mass points), but not all: tiny blobs around a
+// lattice node, saddles, two sheets in one cell. untangle_mesh clears what
+// is left on a whole mesh (contoured, simplified, or any triangle mesh): the
+// vertices of every intersecting triangle pair move to the centroid of their
+// neighbours, a move that would turn a triangle over is halved or undone,
+// and further rounds widen the moved area by a ring of neighbours, until no
+// pair is left (contour/untangle_mesh.cpp). Topology never changes; boundary
+// and non-manifold vertices never move. Pairs are those mesh_quality counts.
+// The tool runs it after contouring and simplification.
+struct UntangleMeshOptions {
+  // Rounds before giving up [Limit: 0..1000]; 0 only counts the pairs.
+  int max_rounds = 50;
+};
+
+struct UntangleMeshStats {
+  size_t pairs_before = 0;    // intersecting pairs found first
+  size_t pairs_after = 0;     // left after the last round (0 unless it gave up)
+  size_t vertices_moved = 0;  // vertices that moved at least once
+  size_t rounds = 0;
+};
+
+Status check_untangle_mesh_options(const UntangleMeshOptions& options);
+
+// Moves vertices of `mesh` until no triangle pair intersects or
+// options.max_rounds is spent (see above). Cost: one pair search over the
+// whole mesh (as in mesh_quality), then per round a search around the moved
+// vertices only. Errors: bad options or a vertex index out of range
+// (kInvalidArgument); cancellation through ctx (kCancelled, positions
+// restored). Stage timer "untangle_mesh" on ctx.
+Result<UntangleMeshStats> untangle_mesh(ContourMesh& mesh, const UntangleMeshOptions& options = {},
+                                        Context* ctx = nullptr);
+
 }  // namespace ldc

@@ -32,12 +32,14 @@
 #include <string>
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/parallel_sort.h>
 
 #include "contour/contour.h"
 #include "contour/detail/grid_cell.h"
+#include "contour/detail/self_intersections.h"
 #include "contour/detail/triangle_intersection.h"
 
 namespace ldc {
@@ -229,102 +231,164 @@ struct Entry {
   bool operator<(const Entry& e) const { return cell != e.cell ? cell < e.cell : triangle < e.triangle; }
 };
 
-size_t count_self_intersections(const ContourMesh& mesh) {
+// The triangles to test and their boxes: every triangle with edges and
+// corners not on one line, or with `hot`, only those that are hot or whose
+// box meets the box around the hot ones (the rest cannot meet a hot one).
+struct TriangleBoxes {
+  std::vector<uint32_t> ids;   // the triangles to test, ascending
+  std::unique_ptr<Box[]> box;  // by triangle index; not zeroed: written for ids
+};
+
+TriangleBoxes triangle_boxes(const ContourMesh& mesh, const std::vector<uint8_t>* hot) {
   const size_t n = mesh.triangle_count();
-  // Triangles to test (not degenerate) and their boxes.
-  std::vector<uint8_t> testable(n, 0);
-  std::unique_ptr<Box[]> boxes(new Box[n]);  // not zeroed: written where testable
+  TriangleBoxes out{{}, std::unique_ptr<Box[]>(new Box[n])};
+  std::vector<uint8_t> take(n, 0);
+  auto box_of = [&](size_t t) {
+    const glm::uvec3& tri = mesh.triangles[t];
+    const glm::dvec3 &a = mesh.positions[tri.x], &b = mesh.positions[tri.y], &c = mesh.positions[tri.z];
+    return Box{glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+  };
+  Box around{glm::dvec3(-INFINITY), glm::dvec3(INFINITY)};  // everything, without hot
+  if (hot) {
+    around = {glm::dvec3(INFINITY), glm::dvec3(-INFINITY)};
+    for (size_t t = 0; t < n; ++t)
+      if ((*hot)[t] && has_edges(mesh, mesh.triangles[t])) {
+        const Box b = box_of(t);
+        around = {glm::min(around.lo, b.lo), glm::max(around.hi, b.hi)};
+      }
+  }
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t) {
       const glm::uvec3& tri = mesh.triangles[t];
       if (!has_edges(mesh, tri)) continue;
-      const glm::dvec3 &a = mesh.positions[tri.x], &b = mesh.positions[tri.y], &c = mesh.positions[tri.z];
-      if (detail::collinear(a, b, c)) continue;
-      testable[t] = 1;
-      boxes[t] = {glm::min(a, glm::min(b, c)), glm::max(a, glm::max(b, c))};
+      out.box[t] = box_of(t);
+      if (!boxes_overlap(out.box[t], around)) continue;
+      take[t] = !detail::collinear(mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]);
     }
   });
-  std::vector<uint32_t> ids;
+  for (size_t t = 0; t < n; ++t)
+    if (take[t]) out.ids.push_back(static_cast<uint32_t>(t));
+  return out;
+}
+
+// Cells about twice the mean box, at most 2^20 along an axis; grown while
+// big triangles would put more than 16 entries per triangle in the grid.
+// False when there is nothing finite to grid.
+bool size_grid(const std::vector<uint32_t>& ids, const Box* boxes, Grid& grid) {
   Box all{glm::dvec3(INFINITY), glm::dvec3(-INFINITY)};
   double extent_sum = 0.0;
-  for (size_t t = 0; t < n; ++t) {
-    if (!testable[t]) continue;
-    ids.push_back(static_cast<uint32_t>(t));
+  for (uint32_t t : ids) {
     all.lo = glm::min(all.lo, boxes[t].lo);
     all.hi = glm::max(all.hi, boxes[t].hi);
     const glm::dvec3 e = boxes[t].hi - boxes[t].lo;
     extent_sum += std::max(e.x, std::max(e.y, e.z));
   }
-  if (ids.size() < 2) return 0;
   if (!std::isfinite(extent_sum) || !std::isfinite(all.hi.x - all.lo.x) || !std::isfinite(all.hi.y - all.lo.y) ||
       !std::isfinite(all.hi.z - all.lo.z))
-    return 0;  // positions that are not finite: nothing meaningful to count
-
-  // Cells about twice the mean box, at most 2^20 along an axis; grown while
-  // big triangles would put more than 16 entries per triangle in the grid.
-  Grid grid;
+    return false;
   grid.origin = all.lo;
   const double span = std::max(all.hi.x - all.lo.x, std::max(all.hi.y - all.lo.y, all.hi.z - all.lo.z));
   grid.size = std::max({2.0 * extent_sum / double(ids.size()), span / double(1 << 20), 1e-300});
-  std::vector<uint64_t> offset(ids.size() + 1, 0);
   for (;;) {
     for (int k = 0; k < 3; ++k) grid.dims[k] = static_cast<int>(std::floor((all.hi[k] - all.lo[k]) / grid.size)) + 1;
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, ids.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-      for (size_t i = r.begin(); i != r.end(); ++i) offset[i + 1] = grid.cells_of(boxes[ids[i]]);
-    });
-    for (size_t i = 0; i < ids.size(); ++i) offset[i + 1] += offset[i];
-    if (offset.back() <= 16 * uint64_t(ids.size()) + 1024) break;
+    const uint64_t entries = tbb::parallel_reduce(
+        tbb::blocked_range<size_t>(0, ids.size(), 4096), uint64_t{0},
+        [&](const tbb::blocked_range<size_t>& r, uint64_t sum) {
+          for (size_t i = r.begin(); i != r.end(); ++i) sum += grid.cells_of(boxes[ids[i]]);
+          return sum;
+        },
+        [](uint64_t a, uint64_t b) { return a + b; });
+    if (entries <= 16 * uint64_t(ids.size()) + 1024) return true;
     grid.size *= 2.0;
   }
-  const size_t entry_count = offset.back();
-  std::unique_ptr<Entry[]> entries(new Entry[entry_count]);  // not zeroed: every one is written
-  tbb::parallel_for(tbb::blocked_range<size_t>(0, ids.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
-    for (size_t i = r.begin(); i != r.end(); ++i) {
-      const glm::ivec3 lo = grid.cell(boxes[ids[i]].lo), hi = grid.cell(boxes[ids[i]].hi);
-      const bool single = lo == hi;
-      uint64_t at = offset[i];
+}
+
+// The grid's (cell, triangle) entries sorted by cell. With `hot`, a triangle
+// that is not hot enters only the cells some hot triangle's box touches.
+std::vector<Entry> grid_entries(const std::vector<uint32_t>& ids, const Box* boxes, const Grid& grid,
+                                const std::vector<uint8_t>* hot) {
+  std::vector<uint64_t> hot_cells;
+  if (hot) {
+    for (uint32_t t : ids) {
+      if (!(*hot)[t]) continue;
+      const glm::ivec3 lo = grid.cell(boxes[t].lo), hi = grid.cell(boxes[t].hi);
       for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
-          for (int x = lo.x; x <= hi.x; ++x) entries[at++] = {grid.key({x, y, z}), ids[i], single};
+          for (int x = lo.x; x <= hi.x; ++x) hot_cells.push_back(grid.key({x, y, z}));
+    }
+    std::sort(hot_cells.begin(), hot_cells.end());
+    hot_cells.erase(std::unique(hot_cells.begin(), hot_cells.end()), hot_cells.end());
+  }
+  tbb::enumerable_thread_specific<std::vector<Entry>> local;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, ids.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<Entry>& out = local.local();
+    for (size_t i = r.begin(); i != r.end(); ++i) {
+      const uint32_t t = ids[i];
+      const glm::ivec3 lo = grid.cell(boxes[t].lo), hi = grid.cell(boxes[t].hi);
+      const bool single = lo == hi, filter = hot && !(*hot)[t];
+      for (int z = lo.z; z <= hi.z; ++z)
+        for (int y = lo.y; y <= hi.y; ++y)
+          for (int x = lo.x; x <= hi.x; ++x) {
+            const uint64_t key = grid.key({x, y, z});
+            if (filter && !std::binary_search(hot_cells.begin(), hot_cells.end(), key)) continue;
+            out.push_back({key, t, single});
+          }
     }
   });
-  tbb::parallel_sort(entries.get(), entries.get() + entry_count);
-  std::vector<size_t> runs;  // entries[runs[k] .. runs[k + 1]) share a cell
-  for (size_t i = 0; i < entry_count; ++i)
-    if (i == 0 || entries[i].cell != entries[i - 1].cell) runs.push_back(i);
-  runs.push_back(entry_count);
-
-  return tbb::parallel_reduce(
-      tbb::blocked_range<size_t>(0, runs.size() - 1, 64), size_t{0},
-      [&](const tbb::blocked_range<size_t>& r, size_t count) {
-        std::vector<Box> cell_boxes;  // the run's boxes side by side
-        for (size_t k = r.begin(); k != r.end(); ++k) {
-          const Entry* run = entries.get() + runs[k];
-          const size_t size = runs[k + 1] - runs[k];
-          cell_boxes.resize(size);
-          for (size_t i = 0; i < size; ++i) cell_boxes[i] = boxes[run[i].triangle];
-          for (size_t i = 0; i < size; ++i) {
-            const Box& bt = cell_boxes[i];
-            for (size_t j = i + 1; j < size; ++j) {
-              const Box& bu = cell_boxes[j];
-              if (!boxes_overlap(bt, bu)) continue;
-              // Tested once: in the cell of the overlap's low corner (which
-              // lies in both boxes, so in this cell if either box has no other).
-              if (!run[i].single_cell && !run[j].single_cell &&
-                  grid.key(grid.cell(glm::max(bt.lo, bu.lo))) != run[0].cell)
-                continue;
-              if (detail::triangle_pair_intersects(mesh.positions.data(), mesh.triangles[run[i].triangle],
-                                                   mesh.triangles[run[j].triangle]))
-                ++count;
-            }
-          }
-        }
-        return count;
-      },
-      [](size_t a, size_t b) { return a + b; });
+  std::vector<Entry> entries;
+  for (const std::vector<Entry>& part : local) entries.insert(entries.end(), part.begin(), part.end());
+  tbb::parallel_sort(entries.begin(), entries.end());
+  return entries;
 }
 
 }  // namespace
+
+namespace detail {
+
+std::vector<TrianglePair> self_intersecting_pairs(const ContourMesh& mesh, const std::vector<uint8_t>* hot) {
+  const TriangleBoxes boxes = triangle_boxes(mesh, hot);
+  const std::vector<uint32_t>& ids = boxes.ids;
+  Grid grid;
+  if (ids.size() < 2 || !size_grid(ids, boxes.box.get(), grid)) return {};  // not finite: nothing meaningful
+  const std::vector<Entry> entries = grid_entries(ids, boxes.box.get(), grid, hot);
+  std::vector<size_t> runs;  // entries[runs[k] .. runs[k + 1]) share a cell
+  for (size_t i = 0; i < entries.size(); ++i)
+    if (i == 0 || entries[i].cell != entries[i - 1].cell) runs.push_back(i);
+  runs.push_back(entries.size());
+
+  tbb::enumerable_thread_specific<std::vector<TrianglePair>> found;
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, runs.size() - 1, 64), [&](const tbb::blocked_range<size_t>& r) {
+    std::vector<Box> cell_boxes;  // the run's boxes side by side
+    std::vector<TrianglePair>& out = found.local();
+    for (size_t k = r.begin(); k != r.end(); ++k) {
+      const Entry* run = entries.data() + runs[k];
+      const size_t size = runs[k + 1] - runs[k];
+      cell_boxes.resize(size);
+      for (size_t i = 0; i < size; ++i) cell_boxes[i] = boxes.box[run[i].triangle];
+      for (size_t i = 0; i < size; ++i) {
+        const Box& bt = cell_boxes[i];
+        for (size_t j = i + 1; j < size; ++j) {
+          const Box& bu = cell_boxes[j];
+          if (!boxes_overlap(bt, bu)) continue;
+          if (hot && !(*hot)[run[i].triangle] && !(*hot)[run[j].triangle]) continue;
+          // Tested once: in the cell of the overlap's low corner (which
+          // lies in both boxes, so in this cell if either box has no other).
+          if (!run[i].single_cell && !run[j].single_cell && grid.key(grid.cell(glm::max(bt.lo, bu.lo))) != run[0].cell)
+            continue;
+          if (triangle_pair_intersects(mesh.positions.data(), mesh.triangles[run[i].triangle],
+                                       mesh.triangles[run[j].triangle]))
+            out.push_back({run[i].triangle, run[j].triangle});
+        }
+      }
+    }
+  });
+  std::vector<TrianglePair> pairs;
+  for (const std::vector<TrianglePair>& part : found) pairs.insert(pairs.end(), part.begin(), part.end());
+  std::sort(pairs.begin(), pairs.end());  // the same order for any thread count
+  return pairs;
+}
+
+}  // namespace detail
 
 MeshQuality mesh_quality(const ContourMesh& mesh) {
   MeshQuality quality;
@@ -332,7 +396,7 @@ MeshQuality mesh_quality(const ContourMesh& mesh) {
   quality.vertices = mesh.vertex_count();
   add_topology(mesh, quality);
   add_shape(mesh, quality);
-  quality.self_intersecting_pairs = count_self_intersections(mesh);
+  quality.self_intersecting_pairs = detail::self_intersecting_pairs(mesh).size();
   return quality;
 }
 

@@ -250,5 +250,140 @@ TEST(Untangle, ChunkedEqualsOnePieceAndUpdatesEqualFreshBuilds) {
   EXPECT_EQ(mesh_quality(a).self_intersecting_pairs, mesh_quality(b).self_intersecting_pairs);
 }
 
+// --- untangle_mesh: what the one local round leaves, cleared on the whole mesh ---
+
+// Contoured (untangling on), then untangle_mesh: a closed 2-manifold without
+// self-intersections, with the pairs found and cleared counted.
+ContourMesh untangled_mesh(const World& w, size_t* pairs_before = nullptr) {
+  ContourMesh m = contour_world(w).value();
+  const UntangleMeshStats stats = untangle_mesh(m).value();
+  if (pairs_before) *pairs_before += stats.pairs_before;
+  EXPECT_EQ(stats.pairs_after, 0u);
+  return m;
+}
+
+void expect_closed(const ContourMesh& m, const std::string& name) {
+  const MeshQuality q = mesh_quality(m);
+  EXPECT_TRUE(q.closed()) << name << ": " << quality_failures(q);
+  if (q.triangles > 0) EXPECT_GT(q.volume, 0.0) << name;
+}
+
+TEST(UntangleMesh, ClearsEveryCornerConfigurationOfACell) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> magnitude(0.2, 1.0);
+  size_t pairs = 0;
+  for (unsigned config = 1; config < 256; ++config) {
+    std::vector<double> values(64, 1.0);
+    for (int c = 0; c < 8; ++c) {
+      const glm::ivec3 node = glm::ivec3(1) + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2);
+      values[size_t((node.z * 4 + node.y) * 4 + node.x)] = ((config >> c) & 1 ? -1.0 : 1.0) * magnitude(rng);
+    }
+    expect_closed(untangled_mesh(field_world(4, values), &pairs), "config " + std::to_string(config));
+  }
+  EXPECT_GT(pairs, 100u);  // the case is real: the contoured meshes had pairs to clear
+}
+
+TEST(UntangleMesh, ClearsRandomBlocks) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  size_t pairs = 0;
+  for (int n : {4, 5, 6}) {  // 2^3, 3^3 and 4^3 cells: dense tangles, some cleared only after 20-50 rounds
+    for (int trial = 0; trial < 400; ++trial) {
+      std::vector<double> values(size_t(n * n * n), 1.0);
+      for (int z = 1; z + 1 < n; ++z)
+        for (int y = 1; y + 1 < n; ++y)
+          for (int x = 1; x + 1 < n; ++x) values[size_t((z * n + y) * n + x)] = value(rng);
+      expect_closed(untangled_mesh(field_world(n, values), &pairs),
+                    std::to_string(n - 2) + "^3 trial " + std::to_string(trial));
+    }
+  }
+  EXPECT_GT(pairs, 100u);
+}
+
+TEST(UntangleMesh, ClearsThinSlabAndBoxesTouchingAlongAnEdge) {
+  std::vector<double> slab(6 * 6 * 6, 1.0);
+  for (int y = 1; y < 5; ++y)
+    for (int x = 1; x < 5; ++x) slab[size_t((2 * 6 + y) * 6 + x)] = -0.5;
+  size_t pairs = 0;
+  expect_closed(untangled_mesh(field_world(6, slab), &pairs), "slab");
+  std::vector<double> boxes(7 * 7 * 7, 1.0);
+  for (int z = 1; z < 3; ++z)
+    for (int y = 1; y < 3; ++y)
+      for (int x = 1; x < 3; ++x) {
+        boxes[size_t((z * 7 + y) * 7 + x)] = -1.0;
+        boxes[size_t((z * 7 + y + 2) * 7 + x + 2)] = -1.0;
+      }
+  expect_closed(untangled_mesh(field_world(7, boxes), &pairs), "touching along an edge");
+  EXPECT_GT(pairs, 0u);
+}
+
+TEST(UntangleMesh, ClearsTheTestMeshesAt64Cells) {
+  for (const char* name : {"spot.obj", "fandisk.obj", "rocker-arm.obj", "stanford-bunny.obj", "suzanne.obj"}) {
+    World w = build_from_mesh(test::load_test_mesh(name), {.cells = 64}).value();
+    expect_closed(untangled_mesh(w), name);
+  }
+}
+
+// A mesh without normals: one vertex of a sphere pushed through the far
+// side folds its fan through the sphere; the umbrella move brings it back.
+TEST(UntangleMesh, UnfoldsAVertexPushedThroughASphere) {
+  TriangleMesh sphere = test::sphere_mesh(glm::dvec3(0.0), 1.0, 3);
+  ContourMesh m;
+  m.positions = sphere.positions;
+  for (const auto& t : sphere.triangles) m.triangles.push_back(glm::uvec3(t[0], t[1], t[2]));
+  m.positions[0] *= -1.3;
+  ASSERT_GT(mesh_quality(m).self_intersecting_pairs, 0u);
+  const UntangleMeshStats stats = untangle_mesh(m).value();
+  EXPECT_GT(stats.pairs_before, 0u);
+  EXPECT_EQ(stats.pairs_after, 0u);
+  EXPECT_GE(stats.vertices_moved, 1u);
+  expect_closed(m, "sphere with a pushed vertex");
+}
+
+TEST(UntangleMesh, LeavesACleanMeshExactlyAsItWas) {
+  World w = build_from_mesh(test::load_test_mesh("fandisk.obj"), {.cells = 32}).value();
+  ContourMesh m = contour_world(w).value();
+  ASSERT_EQ(mesh_quality(m).self_intersecting_pairs, 0u);
+  const std::vector<glm::dvec3> before = m.positions;
+  const UntangleMeshStats stats = untangle_mesh(m).value();
+  EXPECT_EQ(stats.pairs_before, 0u);
+  EXPECT_EQ(stats.rounds, 0u);
+  EXPECT_EQ(m.positions, before);
+}
+
+// An open sheet folded at its rim: the rim (boundary) vertices stay put.
+TEST(UntangleMesh, BoundaryVerticesNeverMove) {
+  ContourMesh m;
+  // A 3 x 3 grid of quads in z = 0 whose centre vertex (5) is movable and
+  // whose border vertices are boundary; vertex 5's fan then folds through
+  // a flap hinged on the border.
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 4; ++x) m.positions.push_back(glm::dvec3(x, y, 0.0));
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 3; ++x) {
+      const uint32_t a = uint32_t(y * 4 + x);
+      m.triangles.push_back({a, a + 1, a + 5});
+      m.triangles.push_back({a, a + 5, a + 4});
+    }
+  m.positions[5] = glm::dvec3(1.0, 1.0, -1.0);
+  m.positions[0] = glm::dvec3(1.2, 1.2, 1.0);  // a boundary vertex folded over the interior
+  const std::vector<glm::dvec3> before = m.positions;
+  const UntangleMeshStats stats = untangle_mesh(m).value();
+  for (uint32_t v : {0u, 1u, 2u, 3u, 4u, 7u, 8u, 11u, 12u, 13u, 14u, 15u}) EXPECT_EQ(m.positions[v], before[v]) << v;
+  EXPECT_LE(stats.pairs_after, stats.pairs_before);
+}
+
+TEST(UntangleMesh, RefusesBadOptionsAndIndices) {
+  ContourMesh m;
+  m.positions = {glm::dvec3(0.0), glm::dvec3(1.0, 0.0, 0.0), glm::dvec3(0.0, 1.0, 0.0)};
+  m.triangles = {glm::uvec3(0, 1, 3)};
+  const Result<UntangleMeshStats> bad_index = untangle_mesh(m);
+  ASSERT_FALSE(bad_index.ok());
+  EXPECT_NE(bad_index.status().message().find("out of range"), std::string::npos);
+  m.triangles = {glm::uvec3(0, 1, 2)};
+  EXPECT_FALSE(untangle_mesh(m, {.max_rounds = -1}).ok());
+  EXPECT_TRUE(untangle_mesh(m, {.max_rounds = 0}).ok());
+}
+
 }  // namespace
 }  // namespace ldc

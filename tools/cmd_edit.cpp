@@ -144,7 +144,9 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   report["version"] = live.version();
   if (live.meshes()) {
     report["world_output"] = a.output;
-    return write_and_report("edit", live.world(), live.meshes()->assemble(), live.meshes()->stats(), a.mesh, bar,
+    ContourMesh mesh = live.meshes()->assemble();
+    if (Status u = untangle_output(bar.context(), mesh, report); !u.ok()) return fail("edit", u);
+    return write_and_report("edit", live.world(), mesh, live.meshes()->stats(), a.mesh, bar,
                             std::move(report), common, [](const nlohmann::json& r) {
                               nlohmann::json edits_only = r;
                               edits_only["output"] = r["world_output"];

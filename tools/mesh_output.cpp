@@ -66,20 +66,31 @@ nlohmann::json simplify_json(const SimplifyStats& s, double max_error, double ce
           {"max_error_reached", s.max_error_reached}};
 }
 
-// Contours (and simplifies, with --max-error > 0), timing each step.
+// Simplifies within --max-error (cells), timed.
+Status simplify_output(const World& w, const MeshOutputArgs& a, Context* ctx, ContourMesh& mesh,
+                       nlohmann::json& report) {
+  const double max_error = a.max_error_cells * w.lattice().cell_size;
+  ScopedTimer s(nullptr, "");
+  Result<SimplifyStats> simple =
+      simplify_mesh(mesh, {.max_error = max_error, .target_triangles = a.target_triangles}, ctx);
+  report["seconds"]["simplify"] = s.seconds();
+  if (!simple.ok()) return simple.status();
+  report["simplify"] = simplify_json(simple.value(), max_error, a.max_error_cells);
+  return {};
+}
+
+// Contours, simplifies (with --max-error > 0) and untangles (dual
+// contouring with untangling on), timing each step.
 Result<ContourMesh> mesh_world(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats& stats,
                                nlohmann::json& report) {
   ScopedTimer t(nullptr, "");
   Result<ContourMesh> mesh = run_method(w, a, ctx, &stats);
   report["seconds"]["contour"] = t.seconds();
-  if (!mesh.ok() || a.max_error_cells == 0.0) return mesh;
-  const double max_error = a.max_error_cells * w.lattice().cell_size;
-  ScopedTimer s(nullptr, "");
-  Result<SimplifyStats> simple =
-      simplify_mesh(mesh.value(), {.max_error = max_error, .target_triangles = a.target_triangles}, ctx);
-  report["seconds"]["simplify"] = s.seconds();
-  if (!simple.ok()) return simple.status();
-  report["simplify"] = simplify_json(simple.value(), max_error, a.max_error_cells);
+  if (!mesh.ok()) return mesh;
+  if (a.max_error_cells > 0.0)
+    if (Status s = simplify_output(w, a, ctx, mesh.value(), report); !s.ok()) return s;
+  if (a.method != "mc" && a.config.untangle)
+    if (Status s = untangle_output(ctx, mesh.value(), report); !s.ok()) return s;
   return mesh;
 }
 
@@ -101,6 +112,11 @@ void print_report(const nlohmann::json& j) {
                 s["triangles_before"].get<size_t>(), s["triangles_after"].get<size_t>(),
                 s["max_error_cells"].get<double>(), s["max_error"].get<double>(), s["collapses"].get<size_t>());
   }
+  if (j.contains("untangle") && j["untangle"]["pairs_before"].get<size_t>() > 0) {
+    const auto& u = j["untangle"];
+    std::printf("  untangled: %zu self-intersecting pairs -> %zu, %zu vertices moved\n",
+                u["pairs_before"].get<size_t>(), u["pairs_after"].get<size_t>(), u["vertices_moved"].get<size_t>());
+  }
   std::printf("  min angle %.1f deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
   for (const auto& b : q["min_angle_histogram_10deg"]) std::printf(" %zu", b.get<size_t>());
   std::printf("\n  area %.6g, volume %.6g\n", q["area"].get<double>(), q["volume"].get<double>());
@@ -108,6 +124,19 @@ void print_report(const nlohmann::json& j) {
 }
 
 }  // namespace
+
+Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report) {
+  ScopedTimer u(nullptr, "");
+  Result<UntangleMeshStats> untangled = untangle_mesh(mesh, {}, ctx);
+  report["seconds"]["untangle"] = u.seconds();
+  if (!untangled.ok()) return untangled.status();
+  const UntangleMeshStats& s = untangled.value();
+  report["untangle"] = {{"pairs_before", s.pairs_before},
+                        {"pairs_after", s.pairs_after},
+                        {"vertices_moved", s.vertices_moved},
+                        {"rounds", s.rounds}};
+  return {};
+}
 
 void add_mesh_output_options(CLI::App* cmd, MeshOutputArgs& a) {
   cmd->add_option("-o,--output", a.output, "Output mesh (.obj .ply .stl .glb .drc)")->required();

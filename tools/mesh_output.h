@@ -49,11 +49,16 @@ using ExtraReportLines = std::function<void(const nlohmann::json& report)>;
 // added and the contour and export times added to report["seconds"]. With
 // --max-error > 0 the mesh is simplified before it is written: "simplify" in
 // the report (triangles before and after, collapses, refusals) and its time
-// in report["seconds"]["simplify"].
+// in report["seconds"]["simplify"]. Dual-contoured meshes (untangling on)
+// then go through untangle_mesh: "untangle" in the report (pairs found and
+// left, vertices moved) and report["seconds"]["untangle"].
 // Returns the command's exit status.
 int contour_and_report(const std::string& command, const World& world, const MeshOutputArgs& args,
                        ProgressBar& bar, nlohmann::json report, const CommonOptions& common,
                        const ExtraReportLines& extra_lines = {});
+
+// untangle_mesh on `mesh`, reported as contour_and_report does.
+Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report);
 
 // Writes a mesh already made and prints the report, as contour_and_report.
 int write_and_report(const std::string& command, const World& world, const ContourMesh& mesh,
