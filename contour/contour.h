@@ -114,7 +114,12 @@ struct ContourConfig {
   // everywhere else (contour/untangle.cpp; ContourStats::untangled_vertices
   // counts the moves, mesh_quality what is left). It reads placed vertices
   // 4 + ceil(2 cell_slack) cells around each vertex, so chunks and edits
-  // re-mesh that much margin.
+  // re-mesh that much margin. For a mesh in one piece, untangle = false and
+  // then untangle_mesh (after simplify_mesh, if any) is better, and is what
+  // the tools do: it moves only the vertices that cross, so sharp features
+  // stay sharper (fandisk-with-cylinder union at 256 cells: Hausdorff error
+  // 1.7e-3 -> 4.0e-4 of the diagonal, 10,210 -> 5,512 adaptive triangles),
+  // and contouring takes about a third of the time.
   bool untangle = true;
   // Mesh the world chunk by chunk in parallel (the default), or in one
   // piece (for tests; refuses worlds larger than 256 cells along an axis).

@@ -120,9 +120,10 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   nlohmann::json report = {{"input", a.input}, {"script", a.script}, {"output", a.output},
                            {"edits", nlohmann::json::array()}, {"seconds", {{"load", load.seconds()}}}};
   ScopedTimer contour(nullptr, "");
-  // The mesh goes to a file: untangled, unlike a game's chunk meshes (LiveConfig's default).
-  Result<LiveWorld> created = LiveWorld::create(
-      std::move(w).value(), {.meshes = !a.mesh.empty(), .contour = {.untangle = true}}, bar.context());
+  // The chunk meshes as a game keeps them (LiveConfig's default: no local
+  // untangling); the assembled mesh goes through untangle_mesh before it is written.
+  Result<LiveWorld> created =
+      LiveWorld::create(std::move(w).value(), {.meshes = !a.mesh.empty()}, bar.context());
   if (!created.ok()) return fail("edit", created.status());
   LiveWorld& live = created.value();
   if (live.meshes()) report["seconds"]["contour_before_edits"] = contour.seconds();
