@@ -34,11 +34,16 @@ struct Method {
   std::function<ldc::TriangleMesh(const ldc::TriangleMesh&, double)> remesh;  // input, h -> output
 };
 
-ldc::TriangleMesh ldc_remesh(const ldc::TriangleMesh& in, double h, const ldc::ContourConfig& config, bool mc) {
+// As `ldc remesh --max-error 0` does it: dual contouring without the local
+// untangling round, then untangle_mesh on the whole mesh (timed with it).
+ldc::TriangleMesh ldc_remesh(const ldc::TriangleMesh& in, double h, ldc::ContourConfig config, bool mc) {
   ldc::GridConfig grid;
   grid.cell_size = h;
   ldc::World w = ldc::build_from_mesh(in, grid).value();
-  ldc::ContourMesh m = mc ? ldc::marching_cubes(w).value() : ldc::contour_world(w, config).value();
+  if (mc) return ldc::to_triangle_mesh(ldc::marching_cubes(w).value());
+  config.untangle = false;
+  ldc::ContourMesh m = ldc::contour_world(w, config).value();
+  ldc::untangle_mesh(m).value();
   return ldc::to_triangle_mesh(m);
 }
 
