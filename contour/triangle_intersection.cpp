@@ -16,6 +16,7 @@
 //   are not of mixed sign (Pluecker coordinates; a zero is on an edge).
 #include "contour/detail/triangle_intersection.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace ldc::detail {
@@ -190,6 +191,56 @@ bool segment_meets_triangle(const glm::dvec3& a, const glm::dvec3& b, int sa, in
   return !(negative && positive);
 }
 
+// Floating-point filters, each a proof that two triangles do not meet, with
+// a margin (1e-9 of the magnitudes) far above double rounding; when unsure
+// they say nothing and the exact tests decide. They spare the exact
+// predicates the bulk of neighbouring pairs on flat or gently curved
+// surfaces, where everything is nearly coplanar.
+
+// For t = (v, a, b) and u = (v, c, d), projected by (i, j), which is one to
+// one on t's plane: a line through v with a and b strictly on one side and c
+// and d strictly on the other. The projections then meet only at v, and so
+// do the triangles (a common point p != v would project to a common point
+// other than v). The line tried is perpendicular to the difference of the
+// two corners' bisectors: it parts the two sectors of a fan around v.
+bool clearly_apart_at_vertex(const glm::dvec3& v, const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c,
+                             const glm::dvec3& d, int i, int j) {
+  const glm::dvec2 ta(a[i] - v[i], a[j] - v[j]), tb(b[i] - v[i], b[j] - v[j]);
+  const glm::dvec2 uc(c[i] - v[i], c[j] - v[j]), ud(d[i] - v[i], d[j] - v[j]);
+  const double lta = glm::length(ta), ltb = glm::length(tb), luc = glm::length(uc), lud = glm::length(ud);
+  if (!(lta > 0.0 && ltb > 0.0 && luc > 0.0 && lud > 0.0)) return false;
+  const glm::dvec2 n = (ta / lta + tb / ltb) - (uc / luc + ud / lud);
+  const double ln = glm::length(n);
+  auto side = [&](const glm::dvec2& x, double lx) {
+    const double s = glm::dot(x, n), tol = 1e-9 * lx * ln;
+    return s > tol ? 1 : s < -tol ? -1 : 0;
+  };
+  return side(ta, lta) > 0 && side(tb, ltb) > 0 && side(uc, luc) < 0 && side(ud, lud) < 0;
+}
+
+// Two triangles with no shared corner: an axis on which their projections
+// leave a clear gap. Tried: each triangle's normal, and the in-plane normals
+// of each triangle's edges (which part any two disjoint coplanar triangles).
+bool clearly_apart(const glm::dvec3 (&t)[3], const glm::dvec3 (&u)[3]) {
+  auto gap_on = [&](const glm::dvec3& axis) {
+    double t_lo = INFINITY, t_hi = -INFINITY, u_lo = INFINITY, u_hi = -INFINITY, size = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double pt = glm::dot(t[k], axis), pu = glm::dot(u[k], axis);
+      t_lo = std::min(t_lo, pt), t_hi = std::max(t_hi, pt), u_lo = std::min(u_lo, pu), u_hi = std::max(u_hi, pu);
+      size = std::max({size, std::abs(pt), std::abs(pu)});
+    }
+    const double tol = 1e-9 * size;
+    return u_lo > t_hi + tol || t_lo > u_hi + tol;
+  };
+  for (const auto* tri : {&t, &u}) {
+    const glm::dvec3 n = glm::cross((*tri)[1] - (*tri)[0], (*tri)[2] - (*tri)[0]);
+    if (gap_on(n)) return true;
+    for (int k = 0; k < 3; ++k)
+      if (gap_on(glm::cross(n, (*tri)[(k + 1) % 3] - (*tri)[k]))) return true;
+  }
+  return false;
+}
+
 bool same_strict_side(const int (&s)[3]) { return (s[0] > 0 && s[1] > 0 && s[2] > 0) || (s[0] < 0 && s[1] < 0 && s[2] < 0); }
 
 }  // namespace
@@ -283,10 +334,14 @@ bool triangle_pair_intersects(const glm::dvec3* positions, const glm::uvec3& t, 
   const glm::dvec3 pu[3] = {positions[u[0]], positions[u[1]], positions[u[2]]};
   if (shared == 1) {
     // t = (v, a, b), u = (v, c, d): a-b against u, c-d against t.
+    int i, j;
+    projection(pt, i, j);
+    if (clearly_apart_at_vertex(pt[tk], pt[(tk + 1) % 3], pt[(tk + 2) % 3], pu[(uk + 1) % 3], pu[(uk + 2) % 3], i, j))
+      return false;
     return segment_meets_triangle(pt[(tk + 1) % 3], pt[(tk + 2) % 3], pu) ||
            segment_meets_triangle(pu[(uk + 1) % 3], pu[(uk + 2) % 3], pt);
   }
-  return triangles_meet(pt, pu);
+  return !clearly_apart(pt, pu) && triangles_meet(pt, pu);
 }
 
 }  // namespace ldc::detail
