@@ -203,6 +203,15 @@ Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk,
                                 const ContourConfig& config = {}, ContourStats* stats = nullptr);
 
 // Keeps one mesh per chunk and re-meshes only the chunks it is told changed.
+//
+// Adaptive chunk meshes: run simplify_mesh on a copy of a chunk's mesh (for
+// rendering or physics; keep the ChunkMesh itself for updates). It never
+// moves a boundary vertex, and a chunk mesh's boundary is its seam with its
+// neighbours, so chunks simplified one by one, each when it changed, still
+// meet without a crack (tests/test_chunk_adaptive.cpp: fandisk at 96 cells,
+// C = 16, within 0.2 h: the welded chunks stay watertight with under a
+// third of the triangles). Collapses are checked for self-intersections
+// against the chunk's own triangles only, not its neighbours'.
 class ChunkedMesh {
  public:
   // Checks the config and meshes every chunk of the world (in parallel): the
