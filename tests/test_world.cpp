@@ -137,12 +137,31 @@ void damage_first_mixed(World& w, int axis,
   w.set_chunk(target, copy);
 }
 
+// validate() fails and names this kind of damage (issue 26: one mutation
+// test per invariant, each asserting its own message).
+void expect_caught(const ValidationReport& r, const std::string& message) {
+  EXPECT_FALSE(r.ok);
+  EXPECT_GT(r.errors, 0u);
+  bool named = false;
+  for (const std::string& m : r.messages) named = named || m.find(message) != std::string::npos;
+  std::string all;
+  for (const std::string& m : r.messages) all += "\n  " + m;
+  EXPECT_TRUE(named) << "\"" << message << "\" not in: " << r.summary() << all;
+}
+
+TEST(Validate, AnUndamagedWorldPasses) {
+  const ValidationReport r = validate(small_sphere_world());
+  EXPECT_TRUE(r.ok) << r.summary();
+  EXPECT_EQ(r.errors, 0u);
+}
+
 TEST(Validate, CatchesUnsortedPoints) {
   World w = small_sphere_world();
   damage_first_mixed(w, 0, [](int, bool&, std::vector<PackedPoint>& p) {
-    p.push_back(p.front());  // a duplicate out of order (and breaks alternation)
+    std::swap(p.front(), p.back());  // out of order, same count
+    if (p.size() < 2) p.push_back(p.front());
   });
-  EXPECT_FALSE(validate(w).ok);
+  expect_caught(validate(w), "not after");
 }
 
 TEST(Validate, CatchesAPointOnANode) {
@@ -151,14 +170,19 @@ TEST(Validate, CatchesAPointOnANode) {
     int node = std::max(1, p.front().depth / 4096);  // chunk size 16: 4096 steps per cell
     p.front().depth = uint16_t(node * 4096);
   });
-  ValidationReport r = validate(w);
-  EXPECT_FALSE(r.ok);
+  expect_caught(validate(w), "lies on a node");
+}
+
+TEST(Validate, CatchesTheReservedBit) {
+  World w = small_sphere_world();
+  damage_first_mixed(w, 2, [](int, bool&, std::vector<PackedPoint>& p) { p.front().normal |= kPointReservedBit; });
+  expect_caught(validate(w), "reserved bit set");
 }
 
 TEST(Validate, CatchesAFlippedSense) {
   World w = small_sphere_world();
   damage_first_mixed(w, 2, [](int, bool&, std::vector<PackedPoint>& p) { p.front().normal ^= kPointExitBit; });
-  EXPECT_FALSE(validate(w).ok);
+  expect_caught(validate(w), "where an");  // "exit where an enter was due" (or the reverse)
 }
 
 TEST(Validate, CatchesANormalPointingIntoTheSolid) {
@@ -168,7 +192,7 @@ TEST(Validate, CatchesANormalPointingIntoTheSolid) {
     uint32_t sense = p.front().normal & kPointExitBit;
     p.front().normal = encode_normal(-n) | sense;
   });
-  EXPECT_FALSE(validate(w).ok);
+  expect_caught(validate(w), "normal points into the solid");
 }
 
 TEST(Validate, CatchesAxesThatDisagreeAtANode) {
@@ -180,20 +204,28 @@ TEST(Validate, CatchesAxesThatDisagreeAtANode) {
     if (p.front().depth > 4096) p.front().depth = uint16_t(p.front().depth - 4096);
     else p.back().depth = uint16_t(p.back().depth + 4096);
   });
-  ValidationReport r = validate(w);
-  EXPECT_FALSE(r.ok);
-  bool mentions = false;
-  for (const auto& m : r.messages) mentions |= m.find("axes disagree") != std::string::npos;
-  EXPECT_TRUE(mentions) << r.summary();
+  expect_caught(validate(w), "axes disagree");
 }
 
-TEST(Validate, CatchesARayThatBreaksAtAChunkBoundary) {
+TEST(Validate, CatchesARayThatStartsInsideAtTheWorldBox) {
   World w = small_sphere_world();
   damage_first_mixed(w, 1, [](int, bool& start, std::vector<PackedPoint>& p) {
-    start = !start;  // flip the start state and drop a point: alternation holds, continuity does not
+    start = !start;  // flip the start state and drop a point: alternation holds, the box face does not
     p.erase(p.begin());
   });
-  EXPECT_FALSE(validate(w).ok);
+  expect_caught(validate(w), "inside at the world box face");
+}
+
+TEST(Validate, CatchesAStateBreakBetweenChunks) {
+  World w = small_sphere_world();
+  // A layer of empty chunks above the sphere; one of them made solid: rays
+  // enter it from an empty chunk below without crossing a surface.
+  const glm::ivec3 top = w.chunk_origin() + w.chunk_dims() - glm::ivec3(1);
+  ASSERT_TRUE(w.grow_to_include(top, top + glm::ivec3(1, 1, 2)).ok());
+  const glm::ivec3 target = top + glm::ivec3(0, 0, 1);
+  ASSERT_EQ(w.chunk_kind(target), ChunkKind::kEmpty);
+  w.set_uniform_chunk(target, true);
+  expect_caught(validate(w), "state breaks at the boundary to the next chunk");
 }
 
 }  // namespace
