@@ -246,6 +246,14 @@ TEST(DualContouring, EmptyAndSolidWorldsGiveNoTriangles) {
   ContourStats stats;
   EXPECT_EQ(contour_world(empty, {}, nullptr, &stats).value().triangle_count(), 0u);
   EXPECT_EQ(stats.chunks_meshed, 0u);  // skipped without reading a ray
+  // Every chunk solid: no crossing anywhere, so no surface (the box faces
+  // are not a surface of the stored solid).
+  World solid = World::create({.chunk_dims = {2, 2, 2}}).value();
+  for (int z = 0; z < 2; ++z)
+    for (int y = 0; y < 2; ++y)
+      for (int x = 0; x < 2; ++x) solid.set_uniform_chunk(solid.chunk_origin() + glm::ivec3(x, y, z), true);
+  ASSERT_EQ(solid.chunk_kind(solid.chunk_origin()), ChunkKind::kSolid);
+  EXPECT_EQ(contour_world(solid).value().triangle_count(), 0u);
 }
 
 TEST(DualContouring, BadConfigsNameTheirField) {

@@ -223,16 +223,34 @@ TEST(Boolean, DisjointIntersectionIsEmptyAndUnionHoldsBoth) {
   EXPECT_NEAR(u.volume(0), 2.0, 1e-3);
 }
 
-TEST(MeshBoolean, OpenBunnyMinusSphereIsValid) {
+// The open bunny (holes in its base) with a sphere through its back: every
+// op valid, and the volumes add up: |A - B| + |A n B| is the bunny's own
+// volume and |A u B| - |A - B| the sphere's, which an op that dropped or
+// doubled a part would break.
+TEST(MeshBoolean, OpenBunnyAndSphereAreValidAndTheirVolumesAddUp) {
   TriangleMesh bunny = test::load_test_mesh("stanford-bunny.obj");
   MeshBounds bb = mesh_bounds(bunny);
   glm::dvec3 centre = 0.5 * (bb.min + bb.max);
-  TriangleMesh ball = test::sphere_mesh(centre + glm::dvec3(0, 0.3 * bb.extent().y, 0), 0.3 * bb.extent().y, 3);
+  const double radius = 0.3 * bb.extent().y;
+  TriangleMesh ball = test::sphere_mesh(centre + glm::dvec3(0, 0.3 * bb.extent().y, 0), radius, 3);
+  double volume[3] = {0, 0, 0};
   for (BooleanOp op : {BooleanOp::kUnion, BooleanOp::kSubtract, BooleanOp::kIntersect}) {
     Result<World> r = mesh_boolean(bunny, ball, op, {.cells = 48, .chunk_size = 16});
     ASSERT_TRUE(r.ok()) << r.status().message();
     EXPECT_TRUE(is_valid(r.value()));
+    volume[int(op)] = r.value().volume(2);
   }
+  const double u = volume[int(BooleanOp::kUnion)], d = volume[int(BooleanOp::kSubtract)],
+               i = volume[int(BooleanOp::kIntersect)];
+  EXPECT_GT(i, 0.0);
+  EXPECT_GT(d, i);
+  // |A| = |A - B| + |A n B|; |B| = |A u B| - |A - B| (all on one lattice, so nearly exact).
+  const double a = d + i, b = u - d;
+  const double ball_volume = 4.0 / 3.0 * M_PI * radius * radius * radius;
+  EXPECT_NEAR(b, ball_volume, 0.03 * ball_volume);  // the icosphere is a little smaller than the sphere
+  // |A| against the bunny built alone (another lattice: a few percent apart).
+  const double bunny_alone = build_from_mesh(bunny, {.cells = 48, .chunk_size = 16}).value().volume(2);
+  EXPECT_NEAR(a, bunny_alone, 0.03 * bunny_alone);
   TriangleMesh empty;
   Result<World> r = mesh_boolean(bunny, empty, BooleanOp::kUnion, {.cells = 48});
   ASSERT_FALSE(r.ok());

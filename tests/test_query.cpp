@@ -137,21 +137,27 @@ TEST(RayCast, HitsLieOnTheContouredSurface) {
     std::vector<double> errors, untangled_errors;
     int agree = 0, total = 0;
     for (int i = 0; i < 1000; ++i) {
-      const glm::dvec3 o = 2.5 * random_unit(rng), target = 0.9 * random_unit(rng);
+      // Aimed at a point inside every shape (0.45 < the smallest half-extent): every ray hits.
+      const glm::dvec3 o = 2.5 * random_unit(rng), target = 0.45 * random_unit(rng);
       Result<RayHit> hit = queries.ray_cast({o, target - o});
       ASSERT_TRUE(hit.ok());
       ++total;
-      if (!hit->hit) continue;
+      ASSERT_TRUE(hit->hit) << c.name << " ray " << i << " aimed inside missed";
       ++agree;
       errors.push_back(distance_to_mesh(mesh.value(), hit->point, 2 * h) / h);
       untangled_errors.push_back(distance_to_mesh(untangled.value(), hit->point, 2 * h) / h);
     }
     std::sort(untangled_errors.begin(), untangled_errors.end());
-    EXPECT_LT(untangled_errors[untangled_errors.size() * 99 / 100], 0.35) << c.name << " (untangled)";
+    const double untangled_p99 = untangled_errors[untangled_errors.size() * 99 / 100];
+    std::printf("%s: untangled p99 %.3f h\n", c.name, untangled_p99);
+    EXPECT_LT(untangled_p99, 0.35) << c.name << " (untangled)";
     std::sort(errors.begin(), errors.end());
     const double median = errors[errors.size() / 2], p99 = errors[errors.size() * 99 / 100], worst = errors.back();
     std::printf("%s: %d/%d hit, distance to contoured mesh median %.3f h, p99 %.3f h, worst %.3f h\n", c.name, agree,
                 total, median, p99, worst);
+    // Measured p99: sphere 0.005 h, box 0.010 h, cylinder 0.031 h (the
+    // documented query tolerance, kQuerySurfaceTolerance, is 0.25 h).
+    EXPECT_LT(p99, 0.05) << c.name;
     EXPECT_LT(p99, kQuerySurfaceTolerance) << c.name;
   }
 }
