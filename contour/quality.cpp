@@ -390,13 +390,15 @@ std::vector<TrianglePair> self_intersecting_pairs(const ContourMesh& mesh, const
 
 }  // namespace detail
 
-MeshQuality mesh_quality(const ContourMesh& mesh) {
+MeshQuality mesh_quality(const ContourMesh& mesh, const QualityOptions& options) {
   MeshQuality quality;
   quality.triangles = mesh.triangle_count();
   quality.vertices = mesh.vertex_count();
   add_topology(mesh, quality);
   add_shape(mesh, quality);
-  quality.self_intersecting_pairs = detail::self_intersecting_pairs(mesh).size();
+  quality.self_intersecting_pairs = options.known_self_intersecting_pairs
+                                        ? *options.known_self_intersecting_pairs
+                                        : detail::self_intersecting_pairs(mesh).size();
   return quality;
 }
 
