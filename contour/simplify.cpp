@@ -24,13 +24,22 @@
 // tries its targets cheapest first; after a collapse the kept vertex and the
 // two opposite the edge are evaluated again, the other neighbours lazily (an
 // entry at a lower bound of their cost, evaluated when popped; a version
-// number drops stale entries).
+// number drops stale entries). Evaluating a vertex whose fan has one material
+// only takes the minimum over its neighbours (no ring is built or sorted),
+// with each vertex's own quadric error at its position kept up to date.
 //
-// The intersection test (the bulk of the cost) is filtered twice before the
-// exact predicates: pairs sharing a vertex with a changed triangle are left
-// out when the fans around the changed triangles' corners are certainly
-// stars (see star_after), and every other pair first goes through a
-// floating-point separation test with a margin far above rounding (may_meet).
+// The intersection test (the largest cost, with the spatial gather of nearby
+// triangles from a uniform grid) is filtered before the exact predicates:
+// - pairs sharing a vertex with a changed triangle are left out when the
+//   fans around the changed triangles' corners are certainly stars. v's fan
+//   is tested in full (star_after); a neighbour of u whose fan was proven a
+//   star by an earlier collapse keeps that proof's direction, and only its
+//   sectors that take v for u are tested again (star_kept);
+// - every other pair first goes through the changed triangle's own
+//   separating axes (its normal and its edges' normals in its plane, set up
+//   once per changed triangle: this parts most pairs, coplanar ones on flat
+//   faces too), then may_meet's per-pair axes; each with a margin far above
+//   rounding. Only the pairs left go to the exact predicates.
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -43,7 +52,6 @@
 #include <tbb/parallel_for.h>
 
 #include "contour/contour.h"
-#include "contour/detail/grid_cell.h"
 #include "contour/detail/triangle_intersection.h"
 
 namespace ldc {
@@ -89,6 +97,8 @@ Box triangle_box(const glm::dvec3* p, const glm::uvec3& t) {
   return {glm::min(p[t.x], glm::min(p[t.y], p[t.z])), glm::max(p[t.x], glm::max(p[t.y], p[t.z]))};
 }
 
+constexpr uint32_t kNoVertex = std::numeric_limits<uint32_t>::max();
+
 enum TriangleState : uint8_t {
   kAlive = 0,   // tested for intersections, may change
   kFlat = 1,    // corners exactly collinear: kept as is, left out of the intersection tests (as mesh_quality does)
@@ -109,6 +119,7 @@ struct Shared {
   std::vector<glm::uvec3> tris;    // the working copy of the triangles
   std::vector<uint8_t> tstate;     // TriangleState
   std::vector<Quadric> quadric;    // per vertex
+  std::vector<double> self_error;  // per vertex: its quadric's error at its own position
   std::vector<uint8_t> vflags;     // VertexFlag bits
   Box bounds{};
   double max_error2 = 0.0;         // max_error^2
@@ -160,7 +171,8 @@ void edge_ends(const Shared& s, uint32_t v, const uint32_t* tris, size_t count, 
     ends.push_back({r.y, tris[i], true});
     ends.push_back({r.z, tris[i], false});
   }
-  std::sort(ends.begin(), ends.end());
+  for (size_t i = 1; i < ends.size(); ++i)  // insertion sort: fans are small
+    for (size_t j = i; j > 0 && ends[j] < ends[j - 1]; --j) std::swap(ends[j], ends[j - 1]);
 }
 
 // Manifold interior: every edge used twice, once each way (sorted ends come
@@ -192,22 +204,24 @@ glm::dvec3 unit_normal(const glm::dvec3* p, const glm::uvec3& t) {
 // material border edge v -> x, for both triangles, the plane through the edge
 // standing on the triangle (Garland & Heckbert's boundary constraint), so that
 // the bound also holds the border line in place.
-void add_initial_quadric(Shared& s, uint32_t v, const std::vector<EdgeEnd>& ends) {
+void add_initial_quadric(Shared& s, uint32_t v, const std::vector<EdgeEnd>& ends,
+                         const std::vector<glm::dvec3>& normal) {
   Quadric q;
   const glm::dvec3 pv = s.pos[v];
   auto add = [&](const glm::dvec3& n) { q += Quadric::plane(n, -glm::dot(n, pv - s.centre)); };
   for (size_t i = 0; i < ends.size(); ++i)
-    if (ends[i].outgoing) add(unit_normal(s.pos, s.tris[ends[i].tri]));  // each triangle once
+    if (ends[i].outgoing) add(normal[ends[i].tri]);  // each triangle once
   for (size_t i = 0; i + 1 < ends.size(); ++i) {
     if (ends[i].other != ends[i + 1].other || s.material[ends[i].tri] == s.material[ends[i + 1].tri]) continue;
     const glm::dvec3 edge = s.pos[ends[i].other] - pv;
     for (size_t j : {i, i + 1}) {
-      const glm::dvec3 m = glm::cross(edge, unit_normal(s.pos, s.tris[ends[j].tri]));
+      const glm::dvec3 m = glm::cross(edge, normal[ends[j].tri]);
       const double length = glm::length(m);
       if (length > 0.0) add(m / length);
     }
   }
   s.quadric[v] = q;
+  s.self_error[v] = q.error(pv - s.centre);
 }
 
 // Locks and quadrics of every vertex (parallel; each vertex on its own).
@@ -215,6 +229,12 @@ void analyse_vertices(Shared& s, const Incidence& table) {
   const size_t n = table.offset.size() - 1;
   s.vflags.assign(n, 0);
   s.quadric.assign(n, Quadric{});
+  s.self_error.assign(n, 0.0);
+  std::vector<glm::dvec3> normal(s.tris.size());  // unit normals, each computed once
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, s.tris.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
+    for (size_t t = r.begin(); t != r.end(); ++t)
+      if (s.tstate[t] != kFrozen) normal[t] = unit_normal(s.pos, s.tris[t]);
+  });
   tbb::enumerable_thread_specific<std::vector<EdgeEnd>> scratch;
   tbb::parallel_for(tbb::blocked_range<size_t>(0, n, 2048), [&](const tbb::blocked_range<size_t>& r) {
     std::vector<EdgeEnd>& ends = scratch.local();
@@ -227,12 +247,24 @@ void analyse_vertices(Shared& s, const Incidence& table) {
       edge_ends(s, static_cast<uint32_t>(v), tris, count, ends);
       const bool movable = !flat && manifold_interior(s, static_cast<uint32_t>(v), ends);
       s.vflags[v] = kUsed | (movable ? 0 : kLocked);
-      add_initial_quadric(s, static_cast<uint32_t>(v), ends);
+      add_initial_quadric(s, static_cast<uint32_t>(v), ends, normal);
     }
   });
 }
 
 // --- Block layouts -------------------------------------------------------------------
+
+// detail::clamped_grid_cell's cell (the same for every point), without
+// std::floor, a library call on plain x86-64: the quotient is clamped first,
+// and truncation is floor for the positive values left.
+inline glm::ivec3 grid_cell(const glm::dvec3& p, const glm::dvec3& origin, double size, const glm::ivec3& dims) {
+  glm::ivec3 c;
+  for (int k = 0; k < 3; ++k) {
+    const double x = (p[k] - origin[k]) / size;
+    c[k] = x <= 0.0 ? 0 : x >= dims[k] - 1 ? dims[k] - 1 : static_cast<int>(x);
+  }
+  return c;
+}
 
 struct Layout {
   glm::dvec3 origin{0.0};
@@ -240,7 +272,7 @@ struct Layout {
   glm::ivec3 dims{1};
 
   // Monotone in each coordinate (clamped into the grid).
-  glm::ivec3 coords(const glm::dvec3& p) const { return detail::clamped_grid_cell(p, origin, size, dims); }
+  glm::ivec3 coords(const glm::dvec3& p) const { return grid_cell(p, origin, size, dims); }
   uint32_t index(const glm::ivec3& c) const { return static_cast<uint32_t>((c.z * dims.y + c.y) * dims.x + c.x); }
   size_t count() const { return size_t(dims.x) * size_t(dims.y) * size_t(dims.z); }
   glm::ivec3 coords_of(uint32_t i) const { return {int(i % dims.x), int(i / dims.x % dims.y), int(i / dims.x / dims.y)}; }
@@ -315,7 +347,14 @@ void build_pass(const Shared& s, PassInput& p) {
   bucket(nb, [&](auto add) {
     for (uint32_t t = 0; t < s.tris.size(); ++t) {
       if (s.tstate[t] == kDead || s.tstate[t] == kFrozen) continue;
-      const Box box = triangle_box(s.pos, s.tris[t]);
+      // Corners in one block: so is the box (coordinates are monotone).
+      const glm::uvec3& c = s.tris[t];
+      const uint32_t b = p.vertex_block[c.x];
+      if (p.vertex_block[c.y] == b && p.vertex_block[c.z] == b) {
+        add(t, b);
+        continue;
+      }
+      const Box box = triangle_box(s.pos, c);
       const glm::ivec3 lo = p.layout.coords(box.lo), hi = p.layout.coords(box.hi);
       for (int z = lo.z; z <= hi.z; ++z)
         for (int y = lo.y; y <= hi.y; ++y)
@@ -383,7 +422,7 @@ class TriangleGrid {
 
  private:
   static constexpr size_t kLargeCells = 64;
-  glm::ivec3 cell(const glm::dvec3& p) const { return detail::clamped_grid_cell(p, origin_, size_, dims_); }
+  glm::ivec3 cell(const glm::dvec3& p) const { return grid_cell(p, origin_, size_, dims_); }
   static size_t cell_count(const glm::ivec3& lo, const glm::ivec3& hi) {
     return size_t(hi.x - lo.x + 1) * size_t(hi.y - lo.y + 1) * size_t(hi.z - lo.z + 1);
   }
@@ -509,6 +548,51 @@ bool may_meet(const glm::dvec3* p, const glm::uvec3& t, const glm::uvec3& u) {
   return true;
 }
 
+// One triangle's separating axes, set up once for all the triangles it is
+// tested against: its normal and, in its plane, its edges' normals, with its
+// extent along each (the margins of may_meet's axes). Most pairs sharing no
+// vertex are parted on one of them (coplanar pairs on flat faces too), which
+// costs a few dot products where may_meet builds its axes for each pair.
+struct Axes {
+  glm::dvec3 origin{0.0};
+  glm::dvec3 m[4];
+  double margin[4], lo[4], hi[4];
+};
+
+Axes axes_of(const glm::dvec3* p, const glm::uvec3& t) {
+  Axes a;
+  a.origin = p[t.x];
+  const glm::dvec3 r[3] = {glm::dvec3(0.0), p[t.y] - a.origin, p[t.z] - a.origin};
+  const glm::dvec3 n = glm::cross(r[1], r[2]);
+  a.m[0] = n;
+  for (int k = 0; k < 3; ++k) a.m[k + 1] = glm::cross(n, r[(k + 1) % 3] - r[k]);
+  for (int j = 0; j < 4; ++j) {
+    a.margin[j] = kMargin * norm1(a.m[j]);
+    a.lo[j] = INFINITY, a.hi[j] = -INFINITY;
+    for (const glm::dvec3& x : r) {
+      const double d = glm::dot(a.m[j], x), e = a.margin[j] * norm1(x);
+      a.lo[j] = std::min(a.lo[j], d - e), a.hi[j] = std::max(a.hi[j], d + e);
+    }
+  }
+  return a;
+}
+
+// Whether triangle u lies certainly apart from the one of `a` along one of
+// its axes (then the two closed triangles do not meet).
+bool apart(const Axes& a, const glm::dvec3* p, const glm::uvec3& u) {
+  const glm::dvec3 r[3] = {p[u.x] - a.origin, p[u.y] - a.origin, p[u.z] - a.origin};
+  const double n1[3] = {norm1(r[0]), norm1(r[1]), norm1(r[2])};
+  for (int j = 0; j < 4; ++j) {
+    double lo = INFINITY, hi = -INFINITY;
+    for (int k = 0; k < 3; ++k) {
+      const double d = glm::dot(a.m[j], r[k]), e = a.margin[j] * n1[k];
+      lo = std::min(lo, d - e), hi = std::max(hi, d + e);
+    }
+    if (hi < a.lo[j] || a.hi[j] < lo) return true;
+  }
+  return false;
+}
+
 bool pair_intersects(const glm::dvec3* p, const glm::uvec3& t, const glm::uvec3& u) {
   return may_meet(p, t, u) && detail::triangle_pair_intersects(p, t, u);
 }
@@ -566,12 +650,15 @@ class BlockSimplifier {
   void rebuild_grid();
   bool gather_ring(uint32_t lu);
   bool targets(uint32_t lu, std::vector<Candidate>& out);
+  double cheapest(uint32_t lu);
   void evaluate(uint32_t lu);
   void try_collapse(uint32_t lu, BlockStats& stats);
   bool link_condition(uint32_t gu, uint32_t gv);
   Verdict shape_kept(uint32_t gu, uint32_t gv);
-  size_t count_meets(const std::vector<glm::uvec3>& tris, size_t limit, bool& foreign, bool skip_sharing);
-  bool star_after(uint32_t gw, uint32_t gu, uint32_t gv);
+  size_t count_meets(const std::vector<glm::uvec3>& tris, size_t limit, bool& foreign, uint32_t skip_sharing);
+  bool star_after(uint32_t gw, uint32_t gu, uint32_t gv, glm::dvec3& dir);
+  bool star_kept(uint32_t gw, uint32_t gu, uint32_t gv);
+  bool stars_after(uint32_t gu, uint32_t gv);
   bool intersection_free(uint32_t lu, uint32_t gv);
   Verdict check(uint32_t lu, uint32_t gv);
   void apply(uint32_t lu, uint32_t gv);
@@ -621,9 +708,19 @@ class BlockSimplifier {
     double ab;           // norm1(a) * norm1(b)
   };
   std::vector<Sector> sectors_;
+  // Fans known to be stars: star_dir_ is a direction along which every
+  // sector turns counter-clockwise, once around (valid while star_known_).
+  // star_pending_: the directions of the fans a collapse being checked
+  // leaves (v's and u's neighbours'), committed when it is made.
+  std::vector<glm::dvec3> star_dir_;
+  std::vector<uint8_t> star_known_;
+  std::vector<std::pair<uint32_t, glm::dvec3>> star_pending_;
+  bool pending_stars_ = false;
   std::vector<Candidate> candidates_, tries_;
   std::vector<uint32_t> neighbours_;
   std::vector<uint32_t> near_;  // triangles near a collapse
+  std::vector<Box> near_box_;   // their boxes
+  Axes axes_;                   // of the changed triangle being tested
   std::vector<glm::uvec3> changed_;  // u's triangles after the collapse (those not on the edge)
   std::vector<glm::uvec3> old_fan_;  // u's triangles before it
 };
@@ -646,6 +743,8 @@ void BlockSimplifier::load() {
   dirty_.assign(nv, 0);
   key_.assign(nv, INFINITY);
   best_.assign(nv, INFINITY);
+  star_dir_.resize(nv);
+  star_known_.assign(nv, 0);
   for (uint32_t lt = 0; lt < n; ++lt) {
     tri_[lt] = s_.tris[tri_id[lt]];
     box_[lt] = triangle_box(s_.pos, tri_[lt]);
@@ -734,7 +833,7 @@ bool BlockSimplifier::targets(uint32_t lu, std::vector<Candidate>& out) {
   const Quadric& qu = s_.quadric[gu];
   auto add = [&](uint32_t gv) {
     const glm::dvec3 q = s_.pos[gv] - s_.centre;
-    const double error = qu.error(q) + s_.quadric[gv].error(q);
+    const double error = qu.error(q) + s_.self_error[gv];
     if (error <= s_.max_error2) out.push_back({error, gv});
   };
   if (border_edges == 0) {
@@ -754,15 +853,35 @@ bool BlockSimplifier::targets(uint32_t lu, std::vector<Candidate>& out) {
   return !out.empty();
 }
 
+// The error of u's cheapest target (infinity if none). Fans of one
+// material (the common case) take a short way: every neighbour is a target,
+// met once as the corner after u in its triangle; no ring is built (the
+// manifold guard runs when u is tried).
+double BlockSimplifier::cheapest(uint32_t lu) {
+  const uint32_t gu = global(lu);
+  if (s_.vflags[gu] & kLocked) return INFINITY;
+  const std::vector<uint32_t>& fan = fan_[lu];
+  const uint16_t first = fan.empty() ? 0 : tmat_[fan[0]];
+  const Quadric& qu = s_.quadric[gu];
+  bool inside = true, one_material = true;
+  double best = INFINITY;
+  for (uint32_t lt : fan) {  // each neighbour comes once after u in a disc (try_collapse checks the disc)
+    const uint32_t gv = rotated_to(tri_[lt], gu).y;
+    inside = inside && owned(gv);
+    one_material = one_material && tmat_[lt] == first;
+    best = std::min(best, qu.error(s_.pos[gv] - s_.centre) + s_.self_error[gv]);
+  }
+  if (!inside || fan.size() < 3 || !one_material) return targets(lu, candidates_) ? candidates_[0].error : INFINITY;
+  s_.vflags[gu] &= ~kSeam;
+  return best <= s_.max_error2 ? best : INFINITY;
+}
+
 void BlockSimplifier::evaluate(uint32_t lu) {
   ++version_[lu];
   dirty_[lu] = 0;
-  if (targets(lu, candidates_)) {
-    best_[lu] = key_[lu] = candidates_[0].error;
-    heap_.push_back({candidates_[0].error, lu, version_[lu]}), std::push_heap(heap_.begin(), heap_.end());
-  } else {
-    best_[lu] = key_[lu] = INFINITY;
-  }
+  const double best = cheapest(lu);
+  best_[lu] = key_[lu] = best;
+  if (best < INFINITY) heap_.push_back({best, lu, version_[lu]}), std::push_heap(heap_.begin(), heap_.end());
 }
 
 // x's options changed without a full evaluation: marked dirty (evaluated
@@ -782,7 +901,8 @@ bool BlockSimplifier::link_condition(uint32_t gu, uint32_t gv) {
   for (uint32_t lt : fan_[local(gv)])
     for (int k = 0; k < 3; ++k)
       if (tri_[lt][k] != gv) ring_v_.push_back(tri_[lt][k]);
-  std::sort(ring_v_.begin(), ring_v_.end());
+  for (size_t i = 1; i < ring_v_.size(); ++i)  // insertion sort: rings are small
+    for (size_t j = i; j > 0 && ring_v_[j] < ring_v_[j - 1]; --j) std::swap(ring_v_[j], ring_v_[j - 1]);
   ring_v_.erase(std::unique(ring_v_.begin(), ring_v_.end()), ring_v_.end());
   size_t common = 0, opposite = 0;
   auto u_it = ring_u_.begin();
@@ -827,10 +947,6 @@ BlockSimplifier::Verdict BlockSimplifier::shape_kept(uint32_t gu, uint32_t gv) {
   return Verdict::kOk;
 }
 
-// How many pairs `tris` (u's fan, before or after the collapse) are in: with
-// each other and with the block's other live triangles (by mesh_quality's
-// rules). Counting stops past `limit`. A triangle met that straddles the
-// block's border sets `foreign`.
 // Whether w's fan after the collapse u -> v (u's changed triangles in
 // changed_) is certainly a star: seen along the sum N of its triangles'
 // normals, every triangle turns counter-clockwise (dot(n, N) > 0) and the
@@ -838,8 +954,9 @@ BlockSimplifier::Verdict BlockSimplifier::shape_kept(uint32_t gu, uint32_t gv) {
 // no other). Its triangles then meet only where the fan joins them: at w,
 // along shared edges without folding, so no pair of them counts. Each sign
 // certified with a margin over rounding (see kMargin). The fan of an
-// unlocked vertex is one cycle (collapses keep it manifold).
-bool BlockSimplifier::star_after(uint32_t gw, uint32_t gu, uint32_t gv) {
+// unlocked vertex is one cycle (collapses keep it manifold). The direction
+// goes to `dir`.
+bool BlockSimplifier::star_after(uint32_t gw, uint32_t gu, uint32_t gv, glm::dvec3& dir) {
   if (s_.vflags[gw] & kLocked) return false;
   const glm::dvec3* p = s_.pos;
   const glm::dvec3 pw = p[gw];
@@ -878,11 +995,19 @@ bool BlockSimplifier::star_after(uint32_t gw, uint32_t gu, uint32_t gv) {
     const bool outside = ad < -kMargin * norm1(sec.a) * dn || db < -kMargin * norm1(sec.b) * dn;
     if (!outside) return false;
   }
+  dir = n;
   return true;
 }
 
+// How many pairs `tris` (u's fan, before or after the collapse) are in: with
+// each other and with the block's other live triangles (by mesh_quality's
+// rules). Counting stops past `limit`. A triangle met that straddles the
+// block's border sets `foreign`. skip_sharing: a vertex all of `tris` have
+// (v) when pairs sharing a vertex are known not to count (stars_after), or
+// kNoVertex. Pairs sharing none go through the triangle's own separating
+// axes, then may_meet, then the exact test.
 size_t BlockSimplifier::count_meets(const std::vector<glm::uvec3>& tris, size_t limit, bool& foreign,
-                                    bool skip_sharing) {
+                                    uint32_t skip_sharing) {
   const glm::dvec3* p = s_.pos;
   // The triangles near any of them, gathered once.
   Box all = triangle_box(p, tris[0]);
@@ -892,25 +1017,36 @@ size_t BlockSimplifier::count_meets(const std::vector<glm::uvec3>& tris, size_t 
   }
   ++query_;
   near_.clear();
+  near_box_.clear();
   auto gather = [&](uint32_t lt) {
     if (seen_[lt] == query_) return;
     seen_[lt] = query_;
-    if (testable_[lt] && excluded_[lt] != collapse_ && boxes_overlap(all, box_[lt])) near_.push_back(lt);
+    if (!testable_[lt] || excluded_[lt] == collapse_ || !boxes_overlap(all, box_[lt])) return;
+    const glm::uvec3& t = tri_[lt];
+    if (t.x == skip_sharing || t.y == skip_sharing || t.z == skip_sharing) return;  // shares v with all
+    near_.push_back(lt);
+    near_box_.push_back(box_[lt]);
   };
   if (!grid_.for_each_near(all, gather))
     for (uint32_t lt = 0; lt < tri_.size(); ++lt) gather(lt);
   size_t count = 0;
   for (size_t i = 0; i < tris.size() && count <= limit; ++i) {
     const glm::uvec3 ti = tris[i];
-      if (!skip_sharing)  // (otherwise all share v)
+    if (skip_sharing == kNoVertex)  // (otherwise all share v)
       for (size_t j = 0; j < i; ++j) count += pair_intersects(p, ti, tris[j]) ? 1 : 0;
     const Box box = triangle_box(p, ti);
-    for (uint32_t lt : near_) {
-      if (!boxes_overlap(box, box_[lt])) continue;
+    bool have_axes = false;
+    for (size_t j = 0; j < near_.size(); ++j) {
+      if (!boxes_overlap(box, near_box_[j])) continue;
+      const uint32_t lt = near_[j];
       const glm::uvec3& t = tri_[lt];
-      if (skip_sharing && (t.x == ti.x || t.x == ti.y || t.x == ti.z || t.y == ti.x || t.y == ti.y ||
-                           t.y == ti.z || t.z == ti.x || t.z == ti.y || t.z == ti.z))
-        continue;
+      const bool shares = t.x == ti.x || t.x == ti.y || t.x == ti.z || t.y == ti.x || t.y == ti.y ||
+                          t.y == ti.z || t.z == ti.x || t.z == ti.y || t.z == ti.z;
+      if (shares && skip_sharing != kNoVertex) continue;
+      if (!shares) {
+        if (!have_axes) axes_ = axes_of(p, ti), have_axes = true;
+        if (apart(axes_, p, t)) continue;
+      }
       if (!pair_intersects(p, ti, t)) continue;
       ++count;
       foreign = foreign || !owned(t.x) || !owned(t.y) || !owned(t.z);
@@ -932,18 +1068,62 @@ bool BlockSimplifier::intersection_free(uint32_t lu, uint32_t gv) {
   ++collapse_;
   for (uint32_t lt : fan_[lu]) excluded_[lt] = collapse_;
   const uint32_t gu = global(lu);
-  bool stars = star_after(gv, gu, gv);
-  for (size_t i = 0; i < ring_u_.size() && stars; ++i)
-    if (ring_u_[i] != gv) stars = star_after(ring_u_[i], gu, gv);
+  const bool stars = stars_after(gu, gv);
   bool foreign = false;
-  const size_t after = count_meets(changed_, std::numeric_limits<size_t>::max(), foreign, stars);
+  const size_t after = count_meets(changed_, std::numeric_limits<size_t>::max(), foreign, stars ? gv : kNoVertex);
   if (after == 0) return true;
   old_fan_.clear();
   for (uint32_t lt : fan_[lu]) old_fan_.push_back(tri_[lt]);
   bool unused = false;
-  if (count_meets(old_fan_, after, unused, false) > after) return true;
+  if (count_meets(old_fan_, after, unused, kNoVertex) > after) return true;
   if (foreign) s_.vflags[global(lu)] |= kSeam;
   return false;
+}
+
+// A fan known to be a star around direction N stays one when the sectors
+// that take v for u still turn counter-clockwise around N: each such change
+// replaces a wedge x -> u -> y (or x -> u -> v, the sector u -> v dying) by
+// sectors of angle in (0, pi) with the same ends, so the angles still sum
+// to 2 pi (a sum in (0, 2 pi) either way, equal modulo 2 pi) and the fan
+// still goes around once.
+bool BlockSimplifier::star_kept(uint32_t gw, uint32_t gu, uint32_t gv) {
+  const uint32_t lw = local(gw);
+  if (!star_known_[lw]) return false;
+  const glm::dvec3* p = s_.pos;
+  const glm::dvec3 pw = p[gw], n = star_dir_[lw];
+  const double nn = norm1(n);
+  size_t kept = 0;
+  for (uint32_t lt : fan_[lw]) {
+    const glm::uvec3& t = tri_[lt];
+    const bool has_u = t.x == gu || t.y == gu || t.z == gu, has_v = t.x == gv || t.y == gv || t.z == gv;
+    if (has_u && has_v) continue;  // dies
+    ++kept;
+    if (!has_u) continue;
+    const glm::uvec3 r = rotated_to(glm::uvec3(t.x == gu ? gv : t.x, t.y == gu ? gv : t.y, t.z == gu ? gv : t.z), gw);
+    const glm::dvec3 a = p[r.y] - pw, b = p[r.z] - pw;
+    if (!(glm::dot(glm::cross(a, b), n) > kMargin * norm1(a) * norm1(b) * nn)) return false;
+  }
+  return kept >= 3;
+}
+
+// Whether the fans of v and of u's other neighbours are certainly stars
+// after u -> v; their directions go to star_pending_.
+bool BlockSimplifier::stars_after(uint32_t gu, uint32_t gv) {
+  star_pending_.clear();
+  pending_stars_ = false;
+  glm::dvec3 dir;
+  if (!star_after(gv, gu, gv, dir)) return false;
+  star_pending_.push_back({local(gv), dir});
+  for (uint32_t w : ring_u_) {
+    if (w == gv) continue;
+    if (star_kept(w, gu, gv)) {
+      star_pending_.push_back({local(w), star_dir_[local(w)]});
+    } else {
+      if (!star_after(w, gu, gv, dir)) return false;
+      star_pending_.push_back({local(w), dir});
+    }
+  }
+  return pending_stars_ = true;
 }
 
 BlockSimplifier::Verdict BlockSimplifier::check(uint32_t lu, uint32_t gv) {
@@ -979,8 +1159,14 @@ void BlockSimplifier::apply(uint32_t lu, uint32_t gv) {
     fan_[lv].push_back(lt);
   }
   fan_[lu].clear();
+  // The fans that changed: known stars when the check proved them.
+  star_known_[lv] = 0;
+  for (uint32_t w : ring_u_) star_known_[local(w)] = 0;
+  if (pending_stars_)
+    for (const auto& [lw, dir] : star_pending_) star_known_[lw] = 1, star_dir_[lw] = dir;
   if (grid_.entries() > 3 * grid_fresh_entries_ + 64) rebuild_grid();
   s_.quadric[gv] += s_.quadric[gu];
+  s_.self_error[gv] = s_.quadric[gv].error(s_.pos[gv] - s_.centre);
   s_.vflags[gu] &= ~(kUsed | kSeam);
   ++version_[lu];
 }
@@ -1015,7 +1201,7 @@ void BlockSimplifier::reevaluate_after(uint32_t gu, uint32_t gv) {
   const uint32_t lv = local(gv);
   evaluate(lv);
   const glm::dvec3 qv = s_.pos[gv] - s_.centre;
-  const double to_v = s_.quadric[gv].error(qv);
+  const double to_v = s_.self_error[gv];
   auto v_it = ring_v.begin();
   for (uint32_t x : ring_u) {
     if (x == gv || !owned(x)) continue;

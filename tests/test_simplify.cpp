@@ -229,6 +229,34 @@ TEST(Simplify, MaterialBordersStayOnTheirVerticesAndNormalsAndMaterialsFollowThe
   EXPECT_EQ(q1.boundary_edges, q0.boundary_edges);
 }
 
+// A spherical shell one cell thick, simplified within 8 cells: flattening
+// either sphere would push it through the other, so many collapses are
+// refused as intersections (through the pair filters: stars known from
+// earlier collapses, separating axes), and the two sheets never meet.
+class ThinShell final : public ImplicitSolid {
+ public:
+  double value(const glm::dvec3& p) const override {
+    const double r = glm::length(p - glm::dvec3(1.0));
+    return std::max(r - 0.8, 0.78 - r);
+  }
+  WorldBox bounds() const override { return {{0.1, 0.1, 0.1}, {1.9, 1.9, 1.9}}; }
+};
+
+TEST(Simplify, ThinShellSheetsNeverMeet) {
+  ThinShell shell;
+  World w = build_from_implicit(shell, {.cell_size = 0.02, .chunk_size = 16}).value();
+  ContourMesh mesh = contour_world(w).value();
+  const MeshQuality before = mesh_quality(mesh);
+  SimplifyStats stats = simplify_mesh(mesh, {.max_error = 8.0 * w.lattice().cell_size}).value();
+  const MeshQuality after = mesh_quality(mesh);
+  EXPECT_LT(after.triangles, before.triangles / 4);
+  EXPECT_GT(stats.rejected_intersection, 0u);
+  EXPECT_LE(after.self_intersecting_pairs, before.self_intersecting_pairs);
+  EXPECT_EQ(after.boundary_edges, before.boundary_edges);
+  EXPECT_LE(after.nonmanifold_edges, before.nonmanifold_edges);
+  EXPECT_LE(after.degenerate_triangles, before.degenerate_triangles);
+}
+
 TEST(Simplify, SameResultForAnyThreadCount) {
   World w = build_from_mesh(test::load_test_mesh("spot.obj"), {.cells = 96}).value();
   const ContourMesh mesh = contour_world(w).value();
