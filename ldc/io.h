@@ -13,8 +13,10 @@
 //
 // Loading trusts nothing: every size is checked against the file size and the
 // format's limits before anything is allocated, every checksum is verified,
-// every chunk is validated (sorted, alternating, in range, axes agree), and
-// the first problem found is returned as kCorruptData naming the section,
+// every chunk is validated (sorted, alternating, in range, axes agree), the
+// world's rays are checked across chunk boundaries (LoadLimits::validate_world;
+// empty and solid chunk slots cost O(1) to load and check), and the first
+// problem found is returned as kCorruptData naming the section,
 // chunk and field.
 //
 // Thread safety: save/serialize only read the World (const; no edit may run
@@ -45,6 +47,11 @@ struct LoadLimits {
   size_t max_file_bytes = size_t{16} << 30;   // refuse larger files
   size_t max_chunk_raw_bytes = size_t{64} << 20;  // one chunk, uncompressed
   size_t max_total_raw_bytes = size_t{16} << 30;  // all chunks, uncompressed
+  // The world-wide pass after the chunks load (rays continuous across chunk
+  // boundaries, outside at the box faces). Off (`ldc info --no-validate`)
+  // skips it; each chunk's own checks stay, as queries rely on them. Its cost
+  // is O(1) per uniform chunk slot and O(C^2) per mixed one. [Default: on]
+  bool validate_world = true;
 };
 
 Status save_world(const World& world, const std::string& path, const SaveOptions& options = {},

@@ -2,8 +2,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include <tbb/parallel_for.h>
@@ -194,34 +196,105 @@ struct Sample {
   bool hidden = false;
 };
 
-// Points along each segment, about 0.7 pixels apart on the image; segments
-// are clipped to the part in front of the camera.
-std::vector<Sample> sample_path(const std::vector<glm::dvec3>& path, const Camera& cam, double near) {
-  std::vector<Sample> out;
+// The part [u0, u1] of the pixel segment pa -> pb inside the box lo .. hi
+// (Liang-Barsky), or nothing when it misses the box.
+std::optional<std::pair<double, double>> clip_to_box(const glm::dvec2& pa, const glm::dvec2& pb, const glm::dvec2& lo,
+                                                     const glm::dvec2& hi) {
+  double u0 = 0.0, u1 = 1.0;
+  const glm::dvec2 d = pb - pa;
+  const double p[4] = {-d.x, d.x, -d.y, d.y};
+  const double q[4] = {pa.x - lo.x, hi.x - pa.x, pa.y - lo.y, hi.y - pa.y};
+  for (int i = 0; i < 4; ++i) {
+    if (p[i] == 0.0) {
+      if (q[i] < 0.0) return std::nullopt;
+      continue;
+    }
+    const double t = q[i] / p[i];
+    if (p[i] < 0.0) u0 = std::max(u0, t);
+    else u1 = std::min(u1, t);
+  }
+  if (u0 > u1) return std::nullopt;
+  return std::pair{u0, u1};
+}
+
+// The fraction along a -> b (depths da, db) of the point seen at fraction u
+// along its projection: perspective maps a line to a line, but not evenly.
+double unproject_fraction(double u, double da, double db) {
+  const double w = u * da + (1.0 - u) * db;
+  return w > 0.0 ? u * da / w : u;
+}
+
+// The part of one path segment that may touch the image: in front of the
+// camera, then clipped to the image plus `margin` pixels.
+struct SegmentPart {
+  glm::dvec3 a, b;           // its ends in the world
+  double along = 0.0;        // pixels along the whole segment before a
+  double length = 0.0;       // pixels along the whole segment (in front of the camera)
+  double part = 0.0;         // pixels from a to b
+  int samples = 0;           // steps from a to b, about 0.7 pixels each
+  bool clipped_start = false;
+};
+
+std::optional<SegmentPart> visible_part(glm::dvec3 a, glm::dvec3 b, const Camera& cam, double near, double margin) {
+  const double da = glm::dot(a - cam.position(), cam.forward()), db = glm::dot(b - cam.position(), cam.forward());
+  if (da <= near && db <= near) return std::nullopt;
+  if (da <= near) a = glm::mix(a, b, (near * 1.001 - da) / (db - da));
+  if (db <= near) b = glm::mix(b, a, (near * 1.001 - db) / (da - db));
+  auto pa = cam.project(a, near), pb = cam.project(b, near);
+  if (!pa || !pb) return std::nullopt;
+  SegmentPart s;
+  s.length = glm::length(pb->pixel - pa->pixel);
+  const glm::dvec2 lo(-margin), hi(cam.width() + margin, cam.height() + margin);
+  const auto clip = clip_to_box(pa->pixel, pb->pixel, lo, hi);
+  if (!clip) {
+    s.samples = -1;  // off the image: only its length counts
+    return s;
+  }
+  const auto [u0, u1] = *clip;
+  s.a = glm::mix(a, b, unproject_fraction(u0, pa->depth, pb->depth));
+  s.b = glm::mix(a, b, unproject_fraction(u1, pa->depth, pb->depth));
+  s.along = s.length * u0;
+  s.part = s.length * (u1 - u0);
+  s.samples = int(std::clamp(std::ceil(s.part / 0.7), 1.0, 20000.0));
+  s.clipped_start = u0 > 0.0;
+  return s;
+}
+
+// Points along each segment, about 0.7 pixels apart on the image, of the
+// part visible_part keeps, so that a segment costs at most about the image's
+// diagonal in samples whatever its length in the world (issue 24: a path
+// zig-zagging +-10 km at 64 x 64 took 3.7 GB). The samples are counted first:
+// more than `budget` in all is refused before they are made.
+Status sample_path(const std::vector<glm::dvec3>& path, const Camera& cam, double near, double margin,
+                   size_t& budget, std::vector<Sample>& out) {
   if (path.size() == 1) {
     if (auto p = cam.project(path[0], near)) out.push_back({path[0], p->pixel, 0.0, false});
-    return out;
+    return {};
   }
-  double along = 0.0;
+  std::vector<std::optional<SegmentPart>> parts(path.size() - 1);
   for (size_t i = 0; i + 1 < path.size(); ++i) {
-    glm::dvec3 a = path[i], b = path[i + 1];
-    const double da = glm::dot(a - cam.position(), cam.forward()), db = glm::dot(b - cam.position(), cam.forward());
-    if (da <= near && db <= near) continue;
-    if (da <= near) a = glm::mix(a, b, (near * 1.001 - da) / (db - da));
-    if (db <= near) b = glm::mix(b, a, (near * 1.001 - db) / (da - db));
-    auto pa = cam.project(a, near), pb = cam.project(b, near);
-    if (!pa || !pb) continue;
-    const double length = glm::length(pb->pixel - pa->pixel);
-    const int n = int(std::clamp(std::ceil(length / 0.7), 1.0, 20000.0));
-    for (int k = (out.empty() ? 0 : 1); k <= n; ++k) {
-      const glm::dvec3 p = glm::mix(a, b, double(k) / n);
+    parts[i] = visible_part(path[i], path[i + 1], cam, near, margin);
+    if (!parts[i] || parts[i]->samples < 0) continue;
+    if (size_t(parts[i]->samples) + 1 > budget) {
+      return Status(ErrorCode::kTooLarge, "overlay: more than " + std::to_string(kMaxOverlaySamples) +
+                                              " samples on the image; draw fewer path vertices");
+    }
+    budget -= size_t(parts[i]->samples) + 1;
+  }
+  const size_t first = out.size();
+  double along = 0.0;
+  for (const auto& s : parts) {
+    if (!s) continue;
+    // The first sample repeats the previous segment's last unless the start was clipped.
+    for (int k = (out.size() == first || s->clipped_start ? 0 : 1); k <= s->samples; ++k) {
+      const glm::dvec3 p = glm::mix(s->a, s->b, double(k) / s->samples);
       auto pp = cam.project(p, near);
       if (!pp) continue;
-      out.push_back({p, pp->pixel, along + length * k / n, false});
+      out.push_back({p, pp->pixel, along + s->along + s->part * k / s->samples, false});
     }
-    along += length;
+    along += s->length;
   }
-  return out;
+  return {};
 }
 
 // Hidden: a ray from the point toward the camera hits the solid first (the
@@ -248,16 +321,16 @@ Status mark_hidden(const Queries& queries, const Camera& cam, std::vector<Sample
 Status overlay_samples(const Queries& queries, const Camera& cam, const Overlay& overlay, double r,
                        std::vector<Sample>& line, std::vector<Sample>& dots) {
   const double near = 1e-6 * std::max(1.0, glm::length(cam.target() - cam.position()));
+  // Samples wholly off the image need no ray.
+  const double m = 3.0 * r + 2.0;
+  size_t budget = kMaxOverlaySamples;
   for (const auto& path : overlay.paths) {
-    std::vector<Sample> s = sample_path(path, cam, near);
-    line.insert(line.end(), s.begin(), s.end());
+    if (Status s = sample_path(path, cam, near, m, budget, line); !s.ok()) return s;
   }
   for (const glm::dvec3& p : overlay.points) {
     if (auto pp = cam.project(p, near)) dots.push_back({p, pp->pixel, 0.0, false});
   }
-  // Samples wholly off the image need no ray.
   auto off_image = [&](const Sample& s) {
-    const double m = 3.0 * r + 2.0;
     return s.pixel.x < -m || s.pixel.y < -m || s.pixel.x > cam.width() + m || s.pixel.y > cam.height() + m;
   };
   std::erase_if(line, off_image);

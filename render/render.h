@@ -32,6 +32,7 @@
 // bytes for any thread count. Target ldc::render.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -118,6 +119,15 @@ class Camera {
   glm::dvec3 forward_{0.0}, right_{0.0}, up_{0.0};
   double tan_half_ = 1.0;  // tan(fov / 2): the image's half height at distance 1
 };
+
+// Bounds on the overlay (issue 24): the vertices and points one overlay may
+// give, and the samples drawn along its paths. Each path segment is clipped to
+// the image (plus the line's width) before it is sampled about 0.7 pixels
+// apart, so a segment costs at most about (width + height) samples however
+// long it is in the world; more than kMaxOverlaySamples in all is refused with
+// kTooLarge rather than run out of memory.
+inline constexpr size_t kMaxOverlayVertices = 1'000'000;
+inline constexpr size_t kMaxOverlaySamples = 4'000'000;
 
 // What is drawn over the shaded image, in world coordinates.
 struct Overlay {

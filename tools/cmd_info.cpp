@@ -16,7 +16,9 @@ struct InfoArgs {
 int run_info(const InfoArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
   ProgressBar bar(!common.quiet);
-  Result<World> w = load_world(a.input, {}, bar.context());
+  LoadLimits limits;
+  limits.validate_world = !a.no_validate;  // --no-validate skips every optional check, the loader's too
+  Result<World> w = load_world(a.input, limits, bar.context());
   bar.finish();
   if (!w.ok()) return fail("info", w.status());
   nlohmann::json info = world_info_json(w.value(), !a.no_validate);
@@ -33,7 +35,7 @@ void add_info_command(CLI::App& app, CommonOptions& common) {
   auto args = std::make_shared<InfoArgs>();
   CLI::App* cmd = app.add_subcommand("info", "Chunks, rays, points, memory, repairs and validation of a .ldc file");
   cmd->add_option("input", args->input, ".ldc file")->required();
-  cmd->add_flag("--no-validate", args->no_validate, "Skip the full invariant check");
+  cmd->add_flag("--no-validate", args->no_validate, "Skip the full invariant check and the loader's world-wide one (each chunk is still checked)");
   cmd->callback([args, &common] {
     int code = run_info(*args, common);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -26,6 +26,7 @@ colour; misses show the sky. Sun, sky and view turn with --up. A camera inside t
 solid shows purple.
 --overlay FILE draws, with the same camera, a polyline and/or points:
   {"path": [[x,y,z], ...], "points": [[x,y,z], ...]}    ("polyline" is taken for "path")
+(at most 1,000,000 entries in each list; the path is drawn only where it crosses the image).
 Parts hidden behind the solid (a ray cast toward the camera hits it) are drawn
 dimmed and dashed.
 )";
@@ -43,6 +44,11 @@ struct RenderArgs {
 
 Result<std::vector<glm::dvec3>> overlay_points(const nlohmann::json& list, const std::string& where) {
   if (!list.is_array()) return Status(ErrorCode::kParseError, where + " must be an array of [x, y, z]");
+  // Bounded before anything is drawn: the cost of drawing grows with the vertices (issue 24).
+  if (list.size() > kMaxOverlayVertices) {
+    return Status(ErrorCode::kTooLarge, where + ": " + std::to_string(list.size()) + " entries, over the limit of " +
+                                            std::to_string(kMaxOverlayVertices));
+  }
   std::vector<glm::dvec3> out;
   for (size_t i = 0; i < list.size(); ++i) {
     const nlohmann::json& p = list[i];

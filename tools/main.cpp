@@ -1,11 +1,29 @@
-// The ldc command-line tool: one subcommand per capability.
+// The ldc command-line tool: one subcommand per capability. A command-line
+// error exits 1 with its message after "ldc: " (issue 24), as other errors do.
 #include <cstdio>
 #include <exception>
+#include <iostream>
 #include <new>
+#include <sstream>
 
 #include "common.h"
 #include "ldc/io.h"
 #include "ldc/version.h"
+
+namespace {
+
+// A command-line error exits 1 (the documented "error" status, not CLI11's
+// 104-109), its message prefixed "ldc: " like every other error. --help and
+// --version (exit 0) and a subcommand's own exit status pass through.
+int parse_error_exit(const CLI::App& app, const CLI::ParseError& e) {
+  if (e.get_exit_code() == 0 || e.get_name() == "RuntimeError") return app.exit(e);
+  std::ostringstream message;
+  app.exit(e, std::cout, message);
+  std::fprintf(stderr, "ldc: %s", message.str().c_str());
+  return 1;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"ldc: Layered Depth Cube geometry kernel (format version " +
@@ -33,7 +51,7 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    return parse_error_exit(app, e);
   } catch (const std::bad_alloc&) {
     std::fprintf(stderr, "ldc: out of memory\n");
     return 1;
