@@ -265,7 +265,9 @@ ContourMesh untangled_mesh(const World& w, size_t* pairs_before = nullptr) {
 void expect_closed(const ContourMesh& m, const std::string& name) {
   const MeshQuality q = mesh_quality(m);
   EXPECT_TRUE(q.closed()) << name << ": " << quality_failures(q);
-  if (q.triangles > 0) EXPECT_GT(q.volume, 0.0) << name;
+  if (q.triangles > 0) {
+    EXPECT_GT(q.volume, 0.0) << name;
+  }
 }
 
 TEST(UntangleMesh, ClearsEveryCornerConfigurationOfACell) {
