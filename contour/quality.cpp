@@ -39,6 +39,7 @@
 
 #include "contour/contour.h"
 #include "contour/detail/grid_cell.h"
+#include "contour/detail/incidence.h"
 #include "contour/detail/self_intersections.h"
 #include "contour/detail/triangle_intersection.h"
 
@@ -50,29 +51,8 @@ bool has_edges(const ContourMesh& mesh, const glm::uvec3& tri) {
   return tri.x < n && tri.y < n && tri.z < n && tri.x != tri.y && tri.y != tri.z && tri.x != tri.z;
 }
 
-// Triangles around each vertex: triangle[offset[v] .. offset[v + 1]).
-struct Incidence {
-  std::vector<size_t> offset;
-  std::vector<uint32_t> triangle;
-};
-
-Incidence incidence(const ContourMesh& mesh) {
-  Incidence table;
-  table.offset.assign(mesh.vertex_count() + 1, 0);
-  for (const glm::uvec3& tri : mesh.triangles) {
-    if (!has_edges(mesh, tri)) continue;
-    for (int k = 0; k < 3; ++k) ++table.offset[tri[k] + 1];
-  }
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) table.offset[v + 1] += table.offset[v];
-  table.triangle.resize(table.offset.back());
-  std::vector<size_t> next(table.offset.begin(), table.offset.end() - 1);
-  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-    const glm::uvec3& tri = mesh.triangles[t];
-    if (!has_edges(mesh, tri)) continue;
-    for (int k = 0; k < 3; ++k) table.triangle[next[tri[k]]++] = static_cast<uint32_t>(t);
-  }
-  return table;
-}
+using detail::Incidence;
+using detail::incidence;
 
 // One end of an edge at the vertex being scanned: the edge's other end, the
 // triangle (local index among the vertex's triangles) and the direction in
@@ -344,6 +324,24 @@ std::vector<Entry> grid_entries(const std::vector<uint32_t>& ids, const Box* box
 }  // namespace
 
 namespace detail {
+
+Incidence incidence(const ContourMesh& mesh) {
+  Incidence table;
+  table.offset.assign(mesh.vertex_count() + 1, 0);
+  for (const glm::uvec3& tri : mesh.triangles) {
+    if (!has_edges(mesh, tri)) continue;
+    for (int k = 0; k < 3; ++k) ++table.offset[tri[k] + 1];
+  }
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) table.offset[v + 1] += table.offset[v];
+  table.triangle.resize(table.offset.back());
+  std::vector<size_t> next(table.offset.begin(), table.offset.end() - 1);
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    const glm::uvec3& tri = mesh.triangles[t];
+    if (!has_edges(mesh, tri)) continue;
+    for (int k = 0; k < 3; ++k) table.triangle[next[tri[k]]++] = static_cast<uint32_t>(t);
+  }
+  return table;
+}
 
 std::vector<TrianglePair> self_intersecting_pairs(const ContourMesh& mesh, const std::vector<uint8_t>* hot) {
   const TriangleBoxes boxes = triangle_boxes(mesh, hot);

@@ -26,9 +26,11 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "contour/contour.h"
+#include "contour/detail/incidence.h"
 #include "contour/detail/self_intersections.h"
 #include "contour/detail/triangle_intersection.h"
 
@@ -46,17 +48,10 @@ struct Table {
   size_t end(size_t v) const { return offset[v + 1]; }
 };
 
+// The triangles around each vertex (mesh_quality's table).
 Table vertex_triangles(const ContourMesh& mesh) {
-  Table t;
-  t.offset.assign(mesh.vertex_count() + 1, 0);
-  for (const glm::uvec3& tri : mesh.triangles)
-    for (int k = 0; k < 3; ++k) ++t.offset[tri[k] + 1];
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) t.offset[v + 1] += t.offset[v];
-  t.items.resize(t.offset.back());
-  std::vector<size_t> at(t.offset.begin(), t.offset.end() - 1);
-  for (size_t i = 0; i < mesh.triangle_count(); ++i)
-    for (int k = 0; k < 3; ++k) t.items[at[mesh.triangles[i][k]]++] = uint32_t(i);
-  return t;
+  detail::Incidence in = detail::incidence(mesh);
+  return {std::move(in.offset), std::move(in.triangle)};
 }
 
 // Each vertex's neighbours (sorted, once each), and whether the vertex may

@@ -152,15 +152,9 @@ Status write_vdb(const VoxelGrid& grid, const std::string& path, const std::stri
 // Every valid level as occupancy_L<k>, normal_L<k>, albedo_L<k> (as
 // ldc::save_vdb(const Cascades&, ...)).
 Status write_vdb(const Cascades& cascades, const std::string& path, const std::string& source) {
-  std::vector<VoxelGrid> levels;
-  std::vector<std::string> names;
-  for (int k = 0; k < cascades.levels(); ++k) {
-    if (!cascades.level_valid(k)) continue;
-    levels.push_back(cascades.level_grid(k));
-    names.push_back("_L" + std::to_string(k));
-  }
+  const std::vector<NamedLevelGrid> levels = valid_level_grids(cascades);
   std::vector<LdcVdbGrid> grids;
-  for (size_t i = 0; i < levels.size(); ++i) grids.push_back({&levels[i], names[i].c_str()});
+  for (const NamedLevelGrid& l : levels) grids.push_back({&l.grid, l.suffix.c_str()});
   return write_vdb(grids, path, source);
 }
 

@@ -476,6 +476,13 @@ void Cascades::pack(PackedGBuffer* out) const {
   for (int k = 0; k < levels(); ++k) pack_level(k, out);
 }
 
+std::vector<NamedLevelGrid> valid_level_grids(const Cascades& cascades) {
+  std::vector<NamedLevelGrid> out;
+  for (int k = 0; k < cascades.levels(); ++k)
+    if (cascades.level_valid(k)) out.push_back({cascades.level_grid(k), "_L" + std::to_string(k)});
+  return out;
+}
+
 VoxelGrid Cascades::level_grid(int level) const {
   VoxelGrid g;
   g.box = boxes_[size_t(level)];

@@ -100,15 +100,9 @@ Status save_vdb(const VoxelGrid& grid, const std::string& path, const std::strin
 }
 
 Status save_vdb(const Cascades& cascades, const std::string& path, const std::string& source) {
-  std::vector<VoxelGrid> levels;
-  std::vector<std::string> names;
-  for (int k = 0; k < cascades.levels(); ++k) {
-    if (!cascades.level_valid(k)) continue;
-    levels.push_back(cascades.level_grid(k));
-    names.push_back("_L" + std::to_string(k));
-  }
+  const std::vector<NamedLevelGrid> levels = valid_level_grids(cascades);
   std::vector<VdbGridSet> sets;
-  for (size_t i = 0; i < levels.size(); ++i) sets.push_back({&levels[i], names[i]});
+  for (const NamedLevelGrid& l : levels) sets.push_back({&l.grid, l.suffix});
   return save_vdb(sets, path, source);
 }
 

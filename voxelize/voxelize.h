@@ -427,6 +427,15 @@ class Cascades {
   uint64_t frame_ = 0;
 };
 
+// Every valid level of `cascades` as a grid with its name suffix ("_L<k>"),
+// in level order: what the .vdb export writes as occupancy_L<k>, normal_L<k>
+// and albedo_L<k>.
+struct NamedLevelGrid {
+  VoxelGrid grid;
+  std::string suffix;
+};
+std::vector<NamedLevelGrid> valid_level_grids(const Cascades& cascades);
+
 // ---------------------------------------------------------------------------
 // Raw export
 
