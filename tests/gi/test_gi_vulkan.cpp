@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <set>
+#include <string>
+#include <vector>
 
 #include "gi/gi_scenes.h"
 #include "gi_bridge/gi.h"
@@ -34,6 +36,39 @@ std::unique_ptr<GiEngine> vulkan_or_skip(const GiConfig& config = {}) {
 float worst(const glm::vec3& a, const glm::vec3& b) {
   const glm::vec3 d = glm::abs(a - b) / (1.0f + glm::abs(b));
   return std::max({d.x, d.y, d.z});
+}
+
+// On a mismatch: how many entries are off, and the worst ones (voxel,
+// level, face, buffer), so that a run on a device one cannot debug on says
+// where the engines part.
+std::string describe_differences(const GiRadiance& gpu, const GiRadiance& cpu) {
+  struct Entry {
+    float err;
+    size_t s, j;
+  };
+  std::vector<Entry> off;
+  size_t total = 0;
+  for (size_t s = 0; s < cpu.light.size(); ++s) {
+    for (size_t j = 0; j < 18; ++j, ++total) {
+      const float e = worst(gpu.light[s][j], cpu.light[s][j]);
+      if (e > kTolerance) off.push_back({e, s, j});
+    }
+  }
+  std::sort(off.begin(), off.end(), [](const Entry& a, const Entry& b) { return a.err > b.err; });
+  char head[80];
+  std::snprintf(head, sizeof head, "\n%zu of %zu entries off", off.size(), total);
+  std::string text = head;
+  for (size_t i = 0; i < std::min<size_t>(off.size(), 8); ++i) {
+    const Entry& e = off[i];
+    const glm::ivec4& v = cpu.voxels[e.s];
+    const glm::vec3 &g = gpu.light[e.s][e.j], &c = cpu.light[e.s][e.j];
+    char line[240];
+    std::snprintf(line, sizeof line,
+                  "\n  voxel (%d, %d, %d) level %d face %zu buffer %zu: gpu (%.5f, %.5f, %.5f) cpu (%.5f, %.5f, %.5f)",
+                  v.x, v.y, v.z, v.w, e.j / 3, e.j % 3, g.x, g.y, g.z, c.x, c.y, c.z);
+    text += line;
+  }
+  return text;
 }
 
 struct Scene {
@@ -80,7 +115,7 @@ void expect_engines_agree(const GiConfig& config, int passes, bool via_set_light
     }
   }
   EXPECT_GT(max_value, 0.1f);
-  EXPECT_LE(max_err, kTolerance) << "light buffers";
+  EXPECT_LE(max_err, kTolerance) << "light buffers" << describe_differences(rg.value(), rc.value());
   std::vector<glm::dvec3> p;
   std::vector<glm::vec3> n;
   for (int i = 0; i < 64; ++i) {
@@ -100,7 +135,37 @@ void expect_engines_agree(const GiConfig& config, int passes, bool via_set_light
   }
 }
 
+// The engines' kernels make hard decisions (is a voxel ahead of the apex?);
+// a scene whose numbers put one on a tie made the H200 and the CPU engine
+// part by 3% (lit_room's light sits on lattice planes). Moving the light by
+// a micron must not change the light buffers beyond float rounding.
+TEST(GiCpu, LightBuffersDoNotJumpWhenALightOnLatticePlanesMovesByAMicron) {
+  const Scene still = lit_room();
+  auto reference = make_cpu_gi(GiConfig{});
+  ASSERT_TRUE(reference->load(still.cascades, still.lights).ok());
+  ASSERT_TRUE(reference->update_all(3).ok());
+  for (double step : {1e-6, -1e-6}) {
+    Scene moved = lit_room();
+    moved.lights.points[0].position += glm::dvec3(step);
+    auto cpu = make_cpu_gi(GiConfig{});
+    ASSERT_TRUE(cpu->load(moved.cascades, moved.lights).ok());
+    ASSERT_TRUE(cpu->update_all(3).ok());
+    const GiRadiance a = cpu->radiance().value(), b = reference->radiance().value();
+    float max_err = 0.0f;
+    for (size_t s = 0; s < b.light.size(); ++s) {
+      for (size_t j = 0; j < 18; ++j) max_err = std::max(max_err, worst(a.light[s][j], b.light[s][j]));
+    }
+    EXPECT_LE(max_err, kTolerance) << "light moved by " << step << " m" << describe_differences(a, b);
+  }
+}
+
 TEST(GiVulkan, MatchesTheCpuReferencePrecombined) { expect_engines_agree(GiConfig{}, 3); }
+
+TEST(GiVulkan, MatchesTheCpuReferenceUnderTheSkyAlone) {
+  Scene scene = lit_room();
+  scene.lights.points.clear();
+  expect_engines_agree(GiConfig{}, 3, false, scene);
+}
 
 TEST(GiVulkan, MatchesTheCpuReferenceWithThreeFaceLookups) {
   GiConfig c;
