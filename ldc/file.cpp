@@ -1,4 +1,8 @@
 // Whole-file reads and the atomic write (ldc/io.h).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -42,23 +46,106 @@ Result<std::string> read_file(const std::string& path, uint64_t max_bytes) {
   return bytes;
 }
 
+namespace {
+
+// The existing target, if any, must be a regular file: renaming over a
+// folder fails late, over a FIFO or device it silently replaces the node,
+// and over a symbolic link it replaces the link, not what it points to.
+Status check_target(const std::string& path) {
+  struct stat st;
+  if (::lstat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT) return {};
+    return io_error(path, "cannot write", errno);
+  }
+  if (S_ISREG(st.st_mode)) return {};
+  const char* kind = S_ISDIR(st.st_mode)    ? "a folder"
+                     : S_ISLNK(st.st_mode)  ? "a symbolic link"
+                     : S_ISFIFO(st.st_mode) ? "a FIFO"
+                     : S_ISSOCK(st.st_mode) ? "a socket"
+                                            : "a device";
+  return {ErrorCode::kIoError, path + ": cannot write: it is " + std::string(kind) + ", not a regular file"};
+}
+
+// "<folder>/.<name>.XXXXXX": hidden, in the target's folder (so the rename
+// stays on one file system), unique per call.
+std::string temp_template(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  const std::string folder = slash == std::string::npos ? "" : path.substr(0, slash + 1);
+  const std::string name = slash == std::string::npos ? path : path.substr(slash + 1);
+  return folder + "." + name + ".XXXXXX";
+}
+
+std::string folder_of(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+// Writes everything, retrying short writes and EINTR; false with errno set otherwise.
+bool write_all(int fd, std::string_view bytes) {
+  size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      if (n == 0) errno = EIO;
+      return false;
+    }
+    done += size_t(n);
+  }
+  return true;
+}
+
+// Permissions a plain fopen would have given: 0666 less the umask, read
+// from /proc (umask() can only be read by setting it, which would race
+// with other threads creating files); 022 where /proc does not say.
+mode_t default_file_mode() {
+  static const mode_t mode = [] {
+    mode_t mask = 022;
+    if (std::FILE* status = std::fopen("/proc/self/status", "r")) {
+      char line[256];
+      unsigned value = 0;
+      while (std::fgets(line, sizeof line, status)) {
+        if (std::sscanf(line, "Umask: %o", &value) == 1) {
+          mask = mode_t(value);
+          break;
+        }
+      }
+      std::fclose(status);
+    }
+    return mode_t(0666 & ~mask);
+  }();
+  return mode;
+}
+
+}  // namespace
+
 Status write_file_atomically(const std::string& path, std::string_view bytes) {
-  const std::string tmp = path + ".tmp";
-  std::FILE* file = std::fopen(tmp.c_str(), "wb");
-  if (!file) return io_error(path, "cannot write (creating '" + tmp + "')", errno);
-  bool ok = std::fwrite(bytes.data(), 1, bytes.size(), file) == bytes.size() && std::fflush(file) == 0;
+  if (path.empty()) return {ErrorCode::kInvalidArgument, "cannot write: empty output path"};
+  if (Status s = check_target(path); !s.ok()) return s;
+  std::string tmp = temp_template(path);
+  // mkostemp opens with O_CREAT | O_EXCL, which never follows a symbolic link.
+  const int fd = ::mkostemp(tmp.data(), O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) return io_error(path, "cannot write (creating a temp file in " + folder_of(path) + ")", errno);
+  bool ok = ::fchmod(fd, default_file_mode()) == 0 && write_all(fd, bytes) && ::fsync(fd) == 0;
   int error = errno;
-  if (std::fclose(file) != 0 && ok) {
+  if (::close(fd) != 0 && ok) {
     ok = false;
     error = errno;
   }
-  if (ok && std::rename(tmp.c_str(), path.c_str()) != 0) {
+  if (ok && ::rename(tmp.c_str(), path.c_str()) != 0) {
     ok = false;
     error = errno;
   }
   if (!ok) {
-    std::remove(tmp.c_str());
+    ::unlink(tmp.c_str());
     return io_error(path, "cannot write", error);
+  }
+  // The rename is durable once the folder is on disk; a failure here cannot
+  // undo it, and the file is complete, so it is not an error.
+  if (const int dir = ::open(folder_of(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dir >= 0) {
+    (void)::fsync(dir);
+    ::close(dir);
   }
   return {};
 }

@@ -71,9 +71,16 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
 // before more than that is read; errors name the path and the system's reason.
 Result<std::string> read_file(const std::string& path, uint64_t max_bytes = UINT64_MAX);
 
-// Writes `bytes` to `path` through `path + ".tmp"`, flushed, then a rename:
-// a failed or killed write leaves any previous file at `path` intact and,
-// on failure, nothing at `path + ".tmp"`.
+// Writes `bytes` to `path` so that readers see the old file or the whole
+// new one, never a part: a temp file of a fresh name in the same folder
+// (created with O_CREAT | O_EXCL | O_NOFOLLOW, so a planted file or symbolic
+// link is never written through), every write and the close checked,
+// fsync'ed, renamed over `path`, and the folder fsync'ed. The new file gets
+// the usual 0666 & ~umask permissions. A failure (a full disk, a file-size
+// limit, a bad folder) removes the temp file and leaves any previous file
+// at `path` as it was; a process killed mid-write leaves at most a hidden
+// temp file (".<name>.XXXXXX"). Refused: a `path` that exists and is not a
+// regular file (a folder, a FIFO, a device, a socket, a symbolic link).
 Status write_file_atomically(const std::string& path, std::string_view bytes);
 
 }  // namespace ldc

@@ -1,9 +1,20 @@
 // .ldc files: round trips, and corrupt, truncated or hostile files refused cleanly.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "ldc/build.h"
 #include "ldc/detail/crc32.h"
@@ -160,6 +171,120 @@ TEST(LdcFile, UniformChunksCostNoPayload) {
   Result<World> back = deserialize_world(as_string(bytes), "empty");
   ASSERT_TRUE(back.ok());
   EXPECT_EQ(back.value().stats().chunks_empty, 64u);
+}
+
+}  // namespace
+}  // namespace ldc
+
+namespace ldc {
+namespace {
+
+// --- write_file_atomically: what every file ldc writes goes through ---
+
+namespace fs = std::filesystem;
+
+// A fresh, empty folder per test.
+std::string fresh_folder(const std::string& name) {
+  const std::string folder = ::testing::TempDir() + "/atomic_write_" + name;
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  return folder;
+}
+
+std::vector<std::string> names_in(const std::string& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+TEST(AtomicWrite, APlantedSymlinkAtATempNameIsNeverWrittenThrough) {
+  const std::string folder = fresh_folder("symlink_temp");
+  const std::string victim = folder + "/victim.txt", path = folder + "/world.ldc";
+  ASSERT_TRUE(write_file_atomically(victim, "precious").ok());
+  fs::create_symlink(victim, path + ".tmp");  // the temp name writers commonly use
+  ASSERT_TRUE(write_file_atomically(path, "new world").ok());
+  EXPECT_EQ(read_file(victim).value(), "precious");
+  EXPECT_EQ(read_file(path).value(), "new world");
+  EXPECT_EQ(names_in(folder), (std::vector<std::string>{"victim.txt", "world.ldc", "world.ldc.tmp"}));
+}
+
+TEST(AtomicWrite, FoldersFifosAndSymlinksAreRefusedAsTargets) {
+  const std::string folder = fresh_folder("targets");
+  const std::string victim = folder + "/victim.txt";
+  ASSERT_TRUE(write_file_atomically(victim, "precious").ok());
+  fs::create_directory(folder + "/dir");
+  ASSERT_EQ(::mkfifo((folder + "/fifo").c_str(), 0600), 0);
+  fs::create_symlink(victim, folder + "/link");
+  for (auto [name, kind] : {std::pair{"dir", "a folder"}, std::pair{"fifo", "a FIFO"},
+                            std::pair{"link", "a symbolic link"}}) {
+    const std::string path = folder + "/" + name;
+    Status s = write_file_atomically(path, "overwrite");
+    ASSERT_FALSE(s.ok()) << name;
+    EXPECT_EQ(s.code(), ErrorCode::kIoError);
+    EXPECT_EQ(s.message(), path + ": cannot write: it is " + kind + ", not a regular file");
+  }
+  EXPECT_EQ(read_file(victim).value(), "precious");
+  EXPECT_EQ(names_in(folder), (std::vector<std::string>{"dir", "fifo", "link", "victim.txt"}));
+}
+
+// RLIMIT_FSIZE makes the write fail part way (EFBIG) like a full disk.
+TEST(AtomicWrite, AWriteThatFailsPartWayLeavesThePreviousFileAndNoTemp) {
+  const std::string folder = fresh_folder("fails");
+  const std::string path = folder + "/mesh.obj";
+  ASSERT_TRUE(write_file_atomically(path, "old mesh").ok());
+  struct rlimit old_limit;
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  struct rlimit small = old_limit;
+  small.rlim_cur = 4096;
+  auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  Status s = write_file_atomically(path, std::string(100000, 'x'));
+  ::setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  ASSERT_FALSE(s.ok());
+  EXPECT_EQ(s.code(), ErrorCode::kIoError);
+  EXPECT_NE(s.message().find(path + ": cannot write: "), std::string::npos) << s.message();
+  EXPECT_EQ(read_file(path).value(), "old mesh");
+  EXPECT_EQ(names_in(folder), std::vector<std::string>{"mesh.obj"});
+}
+
+TEST(AtomicWrite, NewFilesGetTheUmasksPermissions) {
+  const std::string folder = fresh_folder("mode");
+  const mode_t mask = ::umask(027);
+  Status s = write_file_atomically(folder + "/a.png", "png");
+  ::umask(mask);
+  ASSERT_TRUE(s.ok());
+  // The writer reads the umask once per process, so compare with what it read.
+  struct stat st;
+  ASSERT_EQ(::stat((folder + "/a.png").c_str(), &st), 0);
+  const mode_t got = st.st_mode & 0777;
+  EXPECT_TRUE(got == (0666 & ~mode_t(027)) || got == (0666 & ~mask)) << std::oct << got;
+  EXPECT_NE(got, mode_t(0600)) << "mkstemp's private mode leaked through";
+}
+
+// A writer killed at random moments: the file is always the old or the new
+// content, whole. Hidden temp files may be left; the target never is partial.
+TEST(AtomicWrite, AWriterKilledAtRandomMomentsLeavesTheOldOrTheNewFileWhole) {
+  const std::string folder = fresh_folder("kill");
+  const std::string path = folder + "/world.ldc";
+  const std::string a(1 << 20, 'a'), b(1 << 20, 'b');
+  ASSERT_TRUE(write_file_atomically(path, a).ok());
+  std::mt19937 rng(7);
+  for (int round = 0; round < 40; ++round) {
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      for (int i = 0;; ++i) (void)write_file_atomically(path, i % 2 ? a : b);
+    }
+    ::usleep(useconds_t(200 + rng() % 8000));
+    ::kill(child, SIGKILL);
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    const std::string now = read_file(path).value();
+    ASSERT_TRUE(now == a || now == b) << "round " << round << ": " << now.size() << " bytes";
+  }
+  fs::remove_all(folder);
 }
 
 }  // namespace
