@@ -1,0 +1,61 @@
+# cmake -DCHECKER=readme_figures -DREADME=README.md -DBENCHMARKS=docs/benchmarks.md
+#       -DSPEC=docs/readme_figures.spec -DWORK_DIR=dir -P check_readme_figures.cmake
+# Proves docs.readme_figures can fail: copies README.md into WORK_DIR with the
+# spec's first `figure` changed (its last digit d becomes d+1 mod 10, in the
+# Performance section only), runs the checker on the copy and passes only if
+# it exits 1 and names that figure.
+foreach(var CHECKER README BENCHMARKS SPEC WORK_DIR)
+  if(NOT DEFINED ${var})
+    message(FATAL_ERROR "check_readme_figures.cmake: give -D${var}=...")
+  endif()
+endforeach()
+
+file(STRINGS "${SPEC}" figure_lines REGEX "^figure \"")
+list(LENGTH figure_lines n)
+if(n EQUAL 0)
+  message(FATAL_ERROR "${SPEC} has no figure line")
+endif()
+list(GET figure_lines 0 first)
+string(REGEX MATCH "^figure \"([^\"]*)\"" _ "${first}")
+set(figure "${CMAKE_MATCH_1}")
+if(NOT figure MATCHES "^(.*)([0-9])([^0-9]*)$")
+  message(FATAL_ERROR "the first figure '${figure}' has no digit to change")
+endif()
+set(head_text "${CMAKE_MATCH_1}")
+set(tail_text "${CMAKE_MATCH_3}")
+math(EXPR digit "(${CMAKE_MATCH_2} + 1) % 10")
+set(altered "${head_text}${digit}${tail_text}")
+
+file(READ "${README}" text)
+string(FIND "${text}" "\n## Performance" at)
+if(at LESS 0)
+  message(FATAL_ERROR "${README} has no '## Performance' section")
+endif()
+string(SUBSTRING "${text}" 0 ${at} before)
+string(SUBSTRING "${text}" ${at} -1 section)
+string(FIND "${section}" "${figure}" where)
+if(where LESS 0)
+  message(FATAL_ERROR "the figure '${figure}' is not (on one line) in README's Performance section")
+endif()
+string(LENGTH "${figure}" len)
+string(SUBSTRING "${section}" 0 ${where} head)
+math(EXPR tail_at "${where} + ${len}")
+string(SUBSTRING "${section}" ${tail_at} -1 tail)
+file(MAKE_DIRECTORY "${WORK_DIR}")
+file(WRITE "${WORK_DIR}/README.md" "${before}${head}${altered}${tail}")
+
+execute_process(COMMAND "${CHECKER}" "${WORK_DIR}/README.md" "${BENCHMARKS}" "${SPEC}"
+                RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message(STATUS "README figure '${figure}' changed to '${altered}'; exit status: ${code}\n--- stdout:\n${out}--- stderr:\n${err}---")
+set(failures "")
+if(NOT code STREQUAL "1")
+  string(APPEND failures "exit status '${code}', expected 1\n")
+endif()
+# The message this test wants: README says <altered>, docs/benchmarks.md gives <figure>.
+string(FIND "${out}" "README says '${altered}', docs/benchmarks.md gives '${figure}'" named)
+if(named LESS 0)
+  string(APPEND failures "the checker does not say \"README says '${altered}', docs/benchmarks.md gives '${figure}'\"\n")
+endif()
+if(failures)
+  message(FATAL_ERROR "${failures}")
+endif()
