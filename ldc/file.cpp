@@ -81,21 +81,6 @@ std::string folder_of(const std::string& path) {
   return slash == 0 ? "/" : path.substr(0, slash);
 }
 
-// Writes everything, retrying short writes and EINTR; false with errno set otherwise.
-bool write_all(int fd, std::string_view bytes) {
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      if (n == 0) errno = EIO;
-      return false;
-    }
-    done += size_t(n);
-  }
-  return true;
-}
-
 // Permissions a plain fopen would have given: 0666 less the umask, read
 // from /proc (umask() can only be read by setting it, which would race
 // with other threads creating files); 022 where /proc does not say.
@@ -120,34 +105,102 @@ mode_t default_file_mode() {
 
 }  // namespace
 
-Status write_file_atomically(const std::string& path, std::string_view bytes) {
-  if (path.empty()) return {ErrorCode::kInvalidArgument, "cannot write: empty output path"};
+Result<AtomicFile> AtomicFile::create(const std::string& path) {
+  if (path.empty()) return Status(ErrorCode::kInvalidArgument, "cannot write: empty output path");
   if (Status s = check_target(path); !s.ok()) return s;
   std::string tmp = temp_template(path);
   // mkostemp opens with O_CREAT | O_EXCL, which never follows a symbolic link.
   const int fd = ::mkostemp(tmp.data(), O_CLOEXEC | O_NOFOLLOW);
   if (fd < 0) return io_error(path, "cannot write (creating a temp file in " + folder_of(path) + ")", errno);
-  bool ok = ::fchmod(fd, default_file_mode()) == 0 && write_all(fd, bytes) && ::fsync(fd) == 0;
-  int error = errno;
-  if (::close(fd) != 0 && ok) {
-    ok = false;
-    error = errno;
+  std::FILE* stream = ::fchmod(fd, default_file_mode()) == 0 ? ::fdopen(fd, "wb") : nullptr;
+  if (!stream) {
+    const int error = errno;
+    ::close(fd);
+    ::unlink(tmp.c_str());
+    return io_error(path, "cannot write", error);
   }
-  if (ok && ::rename(tmp.c_str(), path.c_str()) != 0) {
+  return AtomicFile(path, std::move(tmp), stream);
+}
+
+AtomicFile::AtomicFile(AtomicFile&& other) noexcept
+    : path_(std::move(other.path_)), temp_(std::move(other.temp_)), stream_(other.stream_),
+      stream_failed_(other.stream_failed_) {
+  other.stream_ = nullptr;
+  other.temp_.clear();
+}
+
+AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
+  if (this != &other) {
+    discard();
+    path_ = std::move(other.path_);
+    temp_ = std::move(other.temp_);
+    stream_ = other.stream_;
+    stream_failed_ = other.stream_failed_;
+    other.stream_ = nullptr;
+    other.temp_.clear();
+  }
+  return *this;
+}
+
+AtomicFile::~AtomicFile() { discard(); }
+
+void AtomicFile::discard() {
+  if (stream_) std::fclose(stream_);
+  stream_ = nullptr;
+  if (!temp_.empty()) ::unlink(temp_.c_str());
+  temp_.clear();
+}
+
+void AtomicFile::close_stream() {
+  if (!stream_) return;
+  stream_failed_ = std::ferror(stream_) != 0 || std::fclose(stream_) != 0;
+  stream_ = nullptr;
+}
+
+Status AtomicFile::commit() {
+  if (temp_.empty()) return {ErrorCode::kInvalidArgument, path_ + ": cannot write: already committed or discarded"};
+  int error = EIO;
+  bool ok = !stream_failed_;
+  if (stream_) {
+    ok = ok && std::ferror(stream_) == 0 && std::fflush(stream_) == 0 && ::fsync(::fileno(stream_)) == 0;
+    if (!ok) error = errno ? errno : EIO;
+    if (std::fclose(stream_) != 0 && ok) {
+      ok = false;
+      error = errno;
+    }
+    stream_ = nullptr;
+  } else if (ok) {
+    // Written by name (close_stream() first): make that file durable too.
+    const int fd = ::open(temp_.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    ok = fd >= 0 && ::fsync(fd) == 0;
+    if (!ok) error = errno;
+    if (fd >= 0) ::close(fd);
+  }
+  if (ok && ::rename(temp_.c_str(), path_.c_str()) != 0) {
     ok = false;
     error = errno;
   }
   if (!ok) {
-    ::unlink(tmp.c_str());
-    return io_error(path, "cannot write", error);
+    discard();
+    return io_error(path_, "cannot write", error);
   }
+  temp_.clear();
   // The rename is durable once the folder is on disk; a failure here cannot
   // undo it, and the file is complete, so it is not an error.
-  if (const int dir = ::open(folder_of(path).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dir >= 0) {
+  if (const int dir = ::open(folder_of(path_).c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC); dir >= 0) {
     (void)::fsync(dir);
     ::close(dir);
   }
   return {};
+}
+
+Status write_file_atomically(const std::string& path, std::string_view bytes) {
+  Result<AtomicFile> file = AtomicFile::create(path);
+  if (!file.ok()) return file.status();
+  if (std::fwrite(bytes.data(), 1, bytes.size(), file.value().stream()) != bytes.size()) {
+    return io_error(path, "cannot write", errno);  // the temp file goes with `file`
+  }
+  return file.value().commit();
 }
 
 }  // namespace ldc

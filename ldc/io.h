@@ -27,6 +27,7 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -82,5 +83,39 @@ Result<std::string> read_file(const std::string& path, uint64_t max_bytes = UINT
 // temp file (".<name>.XXXXXX"). Refused: a `path` that exists and is not a
 // regular file (a folder, a FIFO, a device, a socket, a symbolic link).
 Status write_file_atomically(const std::string& path, std::string_view bytes);
+
+// The same guarantees for a file written in pieces (streamed JSON, raw
+// arrays) or by a library that opens files by name (OpenVDB):
+//   Result<AtomicFile> f = AtomicFile::create(path);
+//   std::fputs("...", f.value().stream());   // or write to temp_path()
+//   Status s = f.value().commit();
+// An AtomicFile destroyed without commit() removes its temp file, so an
+// error on the way leaves any previous file at `path` as it was.
+class AtomicFile {
+ public:
+  static Result<AtomicFile> create(const std::string& path);
+  AtomicFile(AtomicFile&& other) noexcept;
+  AtomicFile& operator=(AtomicFile&& other) noexcept;
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  ~AtomicFile();
+
+  // Buffered stream on the temp file; null after commit().
+  std::FILE* stream() const { return stream_; }
+  // For writers that open the file by name: close stream() first with
+  // close_stream(), write the whole file at temp_path(), then commit().
+  const std::string& temp_path() const { return temp_; }
+  void close_stream();
+  // Checks the stream, flushes, fsyncs and closes the temp file, then
+  // renames it over the target. Errors name the target.
+  Status commit();
+
+ private:
+  AtomicFile(std::string path, std::string temp, std::FILE* stream) : path_(std::move(path)), temp_(std::move(temp)), stream_(stream) {}
+  void discard();
+  std::string path_, temp_;
+  std::FILE* stream_ = nullptr;
+  bool stream_failed_ = false;
+};
 
 }  // namespace ldc

@@ -3,8 +3,13 @@
 // objects and the errors of bad input.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/resource.h>
+
 #include <cmath>
+#include <csignal>
 #include <cstring>
+#include <filesystem>
 #include <limits>
 #include <memory>
 
@@ -13,6 +18,7 @@
 
 #include "csg/csg.h"
 #include "ldc/build.h"
+#include "ldc/io.h"
 #include "ldc/terrain.h"
 #include "test_util.h"
 #include "voxelize/voxelize.h"
@@ -539,6 +545,40 @@ TEST(VoxelErrors, BadCascadeConfigAndCameraAreRefused) {
   EXPECT_FALSE(ok.update_level(w, 3, glm::dvec3(0.0)).ok());
   World other = sphere_world({0, 0, 0}, 0.5, 0.1);
   EXPECT_NE(ok.update_level(other, 0, glm::dvec3(0.0)).status().message().find("lattice"), std::string::npos);
+}
+
+// save_raw writes "<stem>.raw" and "<stem>.json" through AtomicFile: a
+// write that fails part way (RLIMIT_FSIZE, as a full disk) leaves the
+// previous pair whole and no temp file beside it (before, a truncated .raw).
+TEST(RawExport, AFailedSaveLeavesThePreviousPairWhole) {
+  namespace fs = std::filesystem;
+  const std::string folder = ::testing::TempDir() + "/raw_failed_save";
+  fs::remove_all(folder);
+  fs::create_directories(folder);
+  World w = build_terrain(TerrainConfig{.size_x = 8.0, .size_y = 8.0, .cave_radius = 0.0, .arches = 1}, 0.25, 16).value();
+  VoxelGrid small = voxelize(w, VoxelConfig{.voxel_size = 1.0}).value();
+  VoxelizeOptions faces;
+  faces.faces = true;
+  VoxelGrid big = voxelize(w, VoxelConfig{.voxel_size = 0.25}, faces).value();
+  ASSERT_TRUE(save_raw(small, folder + "/v.raw").ok());
+  const std::string old_raw = read_file(folder + "/v.raw").value(), old_json = read_file(folder + "/v.json").value();
+  struct rlimit old_limit;
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  struct rlimit limit = old_limit;
+  limit.rlim_cur = old_raw.size() + 4096;
+  auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &limit), 0);
+  Status s = save_raw(big, folder + "/v.raw");
+  ::setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find(folder + "/v.raw: cannot write: "), std::string::npos) << s.message();
+  EXPECT_EQ(read_file(folder + "/v.raw").value(), old_raw);
+  EXPECT_EQ(read_file(folder + "/v.json").value(), old_json);
+  size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : fs::directory_iterator(folder)) ++entries;
+  EXPECT_EQ(entries, 2u);
+  fs::remove_all(folder);
 }
 
 }  // namespace

@@ -1,10 +1,11 @@
 // Raw arrays with a JSON header.
 #include <cstdio>
-#include <fstream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "ldc/io.h"
 #include "voxelize/voxelize.h"
 
 namespace ldc {
@@ -60,25 +61,30 @@ std::string json_vec(const T& v) {
   return s.str();
 }
 
+// Both files go through AtomicFile (ldc/io.h): a failure or a kill leaves
+// any previous pair whole, not a truncated .raw beside an old header.
 class RawWriter {
  public:
-  explicit RawWriter(const std::string& path) : stem_(stem_of(path)), out_(stem_ + ".raw", std::ios::binary) {}
-  bool ok() const { return bool(out_); }
-  const std::string& stem() const { return stem_; }
+  explicit RawWriter(const std::string& path) : stem_(stem_of(path)) {
+    Result<AtomicFile> raw = AtomicFile::create(stem_ + ".raw");
+    if (raw.ok()) raw_.emplace(std::move(raw).value());
+    else open_error_ = raw.status();
+  }
+  bool ok() const { return raw_.has_value(); }
+  const Status& open_error() const { return open_error_; }
 
   template <class T>
   void add(const std::string& name, const std::string& type, std::vector<size_t> shape, const T* data, size_t count,
            const std::string& format = "") {
-    out_.write(reinterpret_cast<const char*>(data), std::streamsize(count * sizeof(T)));
+    // A short write sets the stream's error flag, which commit() reports.
+    (void)std::fwrite(data, sizeof(T), count, raw_->stream());
     arrays_.push_back({name, type, std::move(shape), format, count * sizeof(T)});
   }
 
   // The header: `fields` (JSON members, already formatted) and the arrays.
   Status finish(const std::string& fields) {
-    out_.close();
-    if (!out_) return {ErrorCode::kIoError, stem_ + ".raw: write failed"};
-    std::ofstream h(stem_ + ".json");
-    if (!h) return {ErrorCode::kIoError, stem_ + ".json: cannot open for writing"};
+    if (Status s = raw_->commit(); !s.ok()) return s;
+    std::ostringstream h;
     h << "{\n  \"format\": \"ldc-voxels\",\n  \"version\": 1,\n  \"data\": " << json_string(base_name(stem_ + ".raw"))
       << ",\n  \"byte_order\": \"little\",\n" << fields << "  \"arrays\": [";
     size_t offset = 0;
@@ -93,14 +99,13 @@ class RawWriter {
       offset += a.bytes;
     }
     h << "\n  ]\n}\n";
-    h.close();
-    if (!h) return {ErrorCode::kIoError, stem_ + ".json: write failed"};
-    return {};
+    return write_file_atomically(stem_ + ".json", h.str());
   }
 
  private:
   std::string stem_;
-  std::ofstream out_;
+  std::optional<AtomicFile> raw_;
+  Status open_error_;
   std::vector<RawArray> arrays_;
 };
 
@@ -108,7 +113,7 @@ class RawWriter {
 
 Status save_raw(const VoxelGrid& grid, const std::string& path) {
   RawWriter w(path);
-  if (!w.ok()) return {ErrorCode::kIoError, w.stem() + ".raw: cannot open for writing"};
+  if (!w.ok()) return w.open_error();
   const glm::ivec3 d = grid.box.dims;
   w.add("occupancy", "float32", {size_t(d.z), size_t(d.y), size_t(d.x)}, grid.occupancy.data(), grid.occupancy.size());
   std::vector<int32_t> coords;
@@ -138,7 +143,7 @@ Status save_raw(const VoxelGrid& grid, const std::string& path) {
 
 Status save_raw(const Cascades& cascades, const std::string& path) {
   RawWriter w(path);
-  if (!w.ok()) return {ErrorCode::kIoError, w.stem() + ".raw: cannot open for writing"};
+  if (!w.ok()) return w.open_error();
   PackedGBuffer packed;
   cascades.pack(&packed);
   const glm::ivec3 e = packed.extent();

@@ -2,9 +2,13 @@
 #include "voxelize/vdb.h"
 
 #include <exception>
+#include <fstream>
 
+#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Dense.h>
+
+#include "ldc/io.h"
 
 namespace ldc {
 namespace {
@@ -82,17 +86,31 @@ void add_grids(const VdbGridSet& set, const std::string& source, openvdb::GridPt
 }  // namespace
 
 Status save_vdb(const std::vector<VdbGridSet>& grids, const std::string& path, const std::string& source) {
+  // OpenVDB opens the file by name: it writes AtomicFile's temp file, which
+  // is renamed over `path` only once whole (ldc/io.h).
+  Result<AtomicFile> target = AtomicFile::create(path);
+  if (!target.ok()) {
+    std::string why = target.status().message();
+    if (why.rfind(path + ": ", 0) == 0) why.erase(0, path.size() + 2);
+    return {ErrorCode::kIoError, path + ": cannot write the .vdb file: " + why};
+  }
+  target.value().close_stream();
   try {
     openvdb::initialize();
     openvdb::GridPtrVec out;
     for (const VdbGridSet& set : grids) add_grids(set, source, &out);
-    openvdb::io::File file(path);
-    file.write(out);
-    file.close();
+    // io::File::write never checks its stream after writing, so a full
+    // disk gave a truncated file and success; io::Stream writes the same
+    // grids (without the offsets table for random access, which readers
+    // do not need) to a stream whose state is checked here.
+    std::ofstream os(target.value().temp_path(), std::ios::binary | std::ios::trunc);
+    openvdb::io::Stream(os).write(out);
+    os.close();
+    if (!os) return {ErrorCode::kIoError, path + ": cannot write the .vdb file: write failed (disk full?)"};
   } catch (const std::exception& e) {
     return {ErrorCode::kIoError, path + ": cannot write the .vdb file: " + e.what()};
   }
-  return {};
+  return target.value().commit();
 }
 
 Status save_vdb(const VoxelGrid& grid, const std::string& path, const std::string& source) {

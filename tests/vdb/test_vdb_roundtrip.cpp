@@ -1,7 +1,12 @@
 // The .vdb export read back through OpenVDB's own reader.
 #include <gtest/gtest.h>
 
+#include <signal.h>
+#include <sys/resource.h>
+
+#include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 
 #include <openvdb/openvdb.h>
@@ -110,6 +115,41 @@ TEST(Vdb, UnwritablePathIsAnErrorNotAnException) {
   Status s = save_vdb(g, "/no/such/dir/out.vdb");
   ASSERT_FALSE(s.ok());
   EXPECT_NE(s.message().find("/no/such/dir/out.vdb"), std::string::npos);
+}
+
+// OpenVDB writes by name, so save_vdb has it write a temp file that is
+// renamed only once whole: a write that fails part way (RLIMIT_FSIZE, as a
+// full disk) leaves the previous .vdb readable and no temp file beside it.
+TEST(Vdb, AFailedSaveLeavesThePreviousFileReadable) {
+  const std::string folder = temp_path("vdb_failed_save");
+  std::filesystem::remove_all(folder);
+  std::filesystem::create_directories(folder);
+  const std::string path = folder + "/world.vdb";
+  VoxelizeOptions opt;
+  opt.faces = true;
+  Result<VoxelGrid> g = voxelize(small_terrain(), VoxelConfig{.voxel_size = 0.25}, opt);
+  ASSERT_TRUE(g.ok());
+  VoxelGrid tiny;
+  tiny.voxel_size = 1.0;
+  ASSERT_TRUE(save_vdb(tiny, path, "old").ok());
+  const uintmax_t old_size = std::filesystem::file_size(path);
+  struct rlimit old_limit;
+  ASSERT_EQ(::getrlimit(RLIMIT_FSIZE, &old_limit), 0);
+  struct rlimit small = old_limit;
+  small.rlim_cur = old_size + 512;
+  auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  ASSERT_EQ(::setrlimit(RLIMIT_FSIZE, &small), 0);
+  Status s = save_vdb(g.value(), path, "new");
+  ::setrlimit(RLIMIT_FSIZE, &old_limit);
+  std::signal(SIGXFSZ, old_handler);
+  ASSERT_FALSE(s.ok()) << old_size << " -> " << std::filesystem::file_size(path);
+  EXPECT_NE(s.message().find(path + ": cannot write the .vdb file: "), std::string::npos) << s.message();
+  EXPECT_EQ(std::filesystem::file_size(path), old_size);
+  EXPECT_EQ(read_all(path)->size(), 1u);  // the old file's one grid
+  size_t entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(folder)) ++entries;
+  EXPECT_EQ(entries, 1u);
+  std::filesystem::remove_all(folder);
 }
 
 }  // namespace
