@@ -9,8 +9,8 @@ CC=clang CXX=clang++ cmake -S . -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWit
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
   -DLDC_BUILD_FUZZERS=ON -DLDC_BUILD_TESTS=OFF -DLDC_BUILD_TOOLS=OFF \
   -DLDC_BUILD_CAPI=OFF -DLDC_BUILD_EXAMPLES=OFF -DLDC_INSTALL=OFF >/dev/null
-targets=(fuzz_ldc_load fuzz_mesh_parsers fuzz_edits)
-# Only the fuzzers and what they link (not nav, voxelize, GI and their shaders).
+targets=(fuzz_ldc_load fuzz_mesh_parsers fuzz_edits fuzz_json_inputs)
+# Only the fuzzers and what they link (nav for the path inputs; not voxelize, GI and their shaders).
 cmake --build build-fuzz -j "$(nproc 2>/dev/null || echo 2)" --target "${targets[@]}"
 for target in "${targets[@]}"; do
   corpus=$(mktemp -d)

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "common.h"
+#include "json_inputs.h"
 #include "ldc/io.h"
 #include "ldc/internal/vec_text.h"
 
@@ -16,32 +17,6 @@ struct InsideArgs {
   std::string world;
   std::string points;  // file; empty = stdin
 };
-
-// One point per line: "x y z" or "x,y,z"; blank lines and # comments skipped.
-Result<std::vector<glm::dvec3>> read_points(std::istream& in, const std::string& name) {
-  std::vector<glm::dvec3> out;
-  std::string line;
-  for (size_t n = 1; std::getline(in, line); ++n) {
-    size_t hash = line.find('#');
-    if (hash != std::string::npos) line.resize(hash);
-    for (char& c : line) if (c == ',') c = ' ';
-    std::istringstream s(line);
-    glm::dvec3 p;
-    std::string rest;
-    if (!(s >> p.x)) {
-      if (line.find_first_not_of(" \t\r") == std::string::npos) continue;
-      return Status(ErrorCode::kParseError, name + ":" + std::to_string(n) + ": expected 'x y z'");
-    }
-    if (!(s >> p.y >> p.z) || (s >> rest)) {
-      return Status(ErrorCode::kParseError, name + ":" + std::to_string(n) + ": expected three numbers");
-    }
-    if (!detail::is_finite(p)) {
-      return Status(ErrorCode::kParseError, name + ":" + std::to_string(n) + ": coordinate is not finite");
-    }
-    out.push_back(p);
-  }
-  return out;
-}
 
 int run_inside(const InsideArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);

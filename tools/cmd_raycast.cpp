@@ -9,6 +9,7 @@
 
 #include "camera.h"
 #include "common.h"
+#include "json_inputs.h"
 #include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
@@ -46,86 +47,6 @@ std::string number_text(double d) {
   s.precision(10);
   s << d;
   return s.str();
-}
-
-// The checks Queries::ray_cast makes, with the ray's index and field named.
-Status check_ray_fields(const Ray& r, const std::string& where) {
-  if (!detail::is_finite(r.origin)) return {ErrorCode::kInvalidArgument, where + "field 'origin' must hold finite numbers"};
-  if (!detail::is_finite(r.direction)) {
-    return {ErrorCode::kInvalidArgument, where + "field 'direction' must hold finite numbers"};
-  }
-  const double len = glm::length(r.direction);
-  if (!(len > 1e-300) || !std::isfinite(len)) {
-    return {ErrorCode::kInvalidArgument,
-            where + "field 'direction' " + detail::vec_text(r.direction) + " has no usable length (zero or overflowing)"};
-  }
-  if (!(r.max_distance >= 0.0)) {
-    return {ErrorCode::kInvalidArgument, where + "field 'max_distance' " + number_text(r.max_distance) +
-                                             " must be a number >= 0"};
-  }
-  return {};
-}
-
-Result<glm::dvec3> json_vec3(const nlohmann::json& v, const std::string& where, const char* field) {
-  const std::string what = where + "field '" + field + "' ";
-  if (!v.is_array() || v.size() != 3) {
-    return Status(ErrorCode::kParseError, what + "must be an array of three numbers [x, y, z]");
-  }
-  glm::dvec3 out;
-  for (int i = 0; i < 3; ++i) {
-    if (!v[i].is_number()) {
-      return Status(ErrorCode::kParseError, what + "must be an array of three numbers [x, y, z], not holding a " +
-                                                std::string(v[i].type_name()));
-    }
-    out[i] = v[i].get<double>();
-  }
-  return out;
-}
-
-Result<std::vector<Ray>> read_rays(const std::string& path) {
-  Result<nlohmann::json> doc = read_json_file(path);
-  if (!doc.ok()) return doc.status();
-  const nlohmann::json* list = &doc.value();
-  if (list->is_object() && list->contains("rays")) list = &(*list)["rays"];
-  if (!list->is_array()) {
-    return Status(ErrorCode::kParseError, path + ": expected a JSON array of rays, or {\"rays\": [...]}");
-  }
-  std::vector<Ray> rays;
-  rays.reserve(list->size());
-  for (size_t i = 0; i < list->size(); ++i) {
-    const nlohmann::json& r = (*list)[i];
-    const std::string where = path + ": ray " + std::to_string(i) + ": ";
-    if (!r.is_object()) {
-      return Status(ErrorCode::kParseError, where + "expected an object {\"origin\": [x,y,z], \"direction\": [x,y,z]}, "
-                                                    "not " + std::string(r.type_name()));
-    }
-    for (const auto& [key, value] : r.items()) {
-      if (key != "origin" && key != "direction" && key != "max_distance") {
-        return Status(ErrorCode::kParseError,
-                      where + "field '" + key + "' is not known (origin, direction, max_distance)");
-      }
-    }
-    Ray ray;
-    for (const char* field : {"origin", "direction"}) {
-      auto it = r.find(field);
-      if (it == r.end()) return Status(ErrorCode::kParseError, where + "field '" + field + "' is missing");
-      Result<glm::dvec3> v = json_vec3(*it, where, field);
-      if (!v.ok()) return v.status();
-      (field[0] == 'o' ? ray.origin : ray.direction) = v.value();
-    }
-    auto md = r.find("max_distance");
-    if (md != r.end() && !md->is_null()) {
-      if (!md->is_number()) {
-        return Status(ErrorCode::kParseError, where + "field 'max_distance' must be a number, not " +
-                                                  std::string(md->type_name()));
-      }
-      ray.max_distance = md->get<double>();
-    }
-    Status s = check_ray_fields(ray, where);
-    if (!s.ok()) return s;
-    rays.push_back(ray);
-  }
-  return rays;
 }
 
 struct RaySource {

@@ -9,6 +9,7 @@
 
 #include "camera.h"
 #include "common.h"
+#include "json_inputs.h"
 #include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
@@ -39,56 +40,6 @@ struct RenderArgs {
   CameraArgs camera;
   RenderOptions options;  // the overlay is read from `overlay`
 };
-
-// ---- the overlay file ------------------------------------------------------
-
-Result<std::vector<glm::dvec3>> overlay_points(const nlohmann::json& list, const std::string& where) {
-  if (!list.is_array()) return Status(ErrorCode::kParseError, where + " must be an array of [x, y, z]");
-  // Bounded before anything is drawn: the cost of drawing grows with the vertices (issue 24).
-  if (list.size() > kMaxOverlayVertices) {
-    return Status(ErrorCode::kTooLarge, where + ": " + std::to_string(list.size()) + " entries, over the limit of " +
-                                            std::to_string(kMaxOverlayVertices));
-  }
-  std::vector<glm::dvec3> out;
-  for (size_t i = 0; i < list.size(); ++i) {
-    const nlohmann::json& p = list[i];
-    bool ok = p.is_array() && p.size() == 3;
-    glm::dvec3 v(0.0);
-    for (int k = 0; ok && k < 3; ++k) {
-      ok = p[k].is_number() && std::isfinite(p[k].get<double>());
-      if (ok) v[k] = p[k].get<double>();
-    }
-    if (!ok) {
-      std::ostringstream s;
-      s << where << "[" << i << "] must be [x, y, z] (three finite numbers), not " << p.dump();
-      return Status(ErrorCode::kParseError, s.str());
-    }
-    out.push_back(v);
-  }
-  return out;
-}
-
-Result<Overlay> read_overlay(const std::string& path) {
-  Result<nlohmann::json> read = read_json_file(path);
-  if (!read.ok()) return Status(read.status().code(), "--overlay " + read.status().message());
-  const nlohmann::json& doc = read.value();
-  const std::string usage = " (expected {\"path\": [[x,y,z], ...]} and/or {\"points\": [[x,y,z], ...]}; "
-                            "\"polyline\" is taken for \"path\")";
-  if (!doc.is_object()) return Status(ErrorCode::kParseError, "--overlay " + path + ": not a JSON object" + usage);
-  Overlay overlay;
-  bool found = false;
-  for (const char* key : {"path", "polyline", "points"}) {
-    auto it = doc.find(key);
-    if (it == doc.end()) continue;
-    found = true;
-    Result<std::vector<glm::dvec3>> pts = overlay_points(*it, "--overlay " + path + ": " + key);
-    if (!pts.ok()) return pts.status();
-    if (std::string(key) == "points") overlay.points = std::move(pts).value();
-    else overlay.paths.push_back(std::move(pts).value());
-  }
-  if (!found) return Status(ErrorCode::kParseError, "--overlay " + path + ": nothing to draw" + usage);
-  return overlay;
-}
 
 bool has_png_extension(const std::string& path) {
   if (path.size() < 4) return false;

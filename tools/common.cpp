@@ -55,49 +55,6 @@ int fail(const std::string& command, const std::string& message) {
   return 1;
 }
 
-namespace {
-
-template <class Json>
-Result<Json> parse_json_file(const std::string& path, size_t max_bytes) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) return Status(ErrorCode::kIoError, path + ": cannot open: a directory");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return Status(ErrorCode::kIoError, path + ": cannot open");
-  std::string text;
-  if (max_bytes == 0) {
-    std::ostringstream all;
-    all << f.rdbuf();
-    text = std::move(all).str();
-  } else {
-    // One byte past the limit says whether the file is over it, without reading it all.
-    text.resize(max_bytes + 1);
-    f.read(text.data(), std::streamsize(text.size()));
-    text.resize(size_t(f.gcount()));
-    if (text.size() > max_bytes) {
-      return Status(ErrorCode::kTooLarge, path + ": over the limit of " + std::to_string(max_bytes) +
-                                              " bytes for this file");
-    }
-  }
-  try {
-    return Json::parse(text);
-  } catch (const nlohmann::json::exception& e) {  // syntax errors, and numbers too large for a double
-    const std::string what = e.what();
-    const bool not_finite = what.find("invalid literal") != std::string::npos || what.find("overflow") != std::string::npos;
-    return Status(ErrorCode::kParseError, path + ": malformed JSON: " + what +
-                                              (not_finite ? " (JSON has no NaN or Infinity: every number must be finite)" : ""));
-  }
-}
-
-}  // namespace
-
-Result<nlohmann::json> read_json_file(const std::string& path, size_t max_bytes) {
-  return parse_json_file<nlohmann::json>(path, max_bytes);
-}
-
-Result<nlohmann::ordered_json> read_ordered_json_file(const std::string& path, size_t max_bytes) {
-  return parse_json_file<nlohmann::ordered_json>(path, max_bytes);
-}
-
 bool parse_numbers(const std::string& text, std::vector<double>* out) {
   std::istringstream in(text);
   std::vector<double> v;

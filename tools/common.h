@@ -47,12 +47,7 @@ class ProgressBar {
 int fail(const std::string& command, const Status& status);
 int fail(const std::string& command, const std::string& message);
 
-// Reads and parses a JSON file; errors name the file (and, for NaN or
-// Infinity, which JSON cannot hold, say so). A file over max_bytes (0: no
-// limit) is refused (kTooLarge) without reading it whole.
-Result<nlohmann::json> read_json_file(const std::string& path, size_t max_bytes = 0);
-// The same, keeping objects' keys in the file's order.
-Result<nlohmann::ordered_json> read_ordered_json_file(const std::string& path, size_t max_bytes = 0);
+// Reading JSON input files: json_inputs.h.
 
 // Whether a path ends in .ldc (any case).
 bool has_ldc_extension(const std::string& path);

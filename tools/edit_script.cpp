@@ -12,8 +12,8 @@
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
-#include "common.h"
 #include "json_fields.h"
+#include "json_inputs.h"
 #include "meshio/meshio.h"
 
 namespace ldc::tool {
@@ -43,13 +43,13 @@ using EditFields = JsonFields<nlohmann::json>;
 // Mesh brushes' files, each loaded once however many edits use it.
 class MeshFiles {
  public:
-  explicit MeshFiles(std::filesystem::path folder) : folder_(std::move(folder)) {}
+  MeshFiles(std::filesystem::path folder, const MeshLoader& load) : folder_(std::move(folder)), load_(load) {}
   std::shared_ptr<const TriangleMesh> load(const std::string& file, EditFields& f) {
     std::filesystem::path path(file);
     if (path.is_relative()) path = folder_ / path;  // relative to the script, not the working folder
     auto found = meshes_.find(path.string());
     if (found != meshes_.end()) return found->second;
-    Result<TriangleMesh> mesh = load_mesh(path.string());
+    Result<TriangleMesh> mesh = load_(path.string());
     if (!mesh.ok()) {
       f.fail("mesh", "('" + file + "'): " + mesh.status().to_string());
       return nullptr;
@@ -61,6 +61,7 @@ class MeshFiles {
 
  private:
   std::filesystem::path folder_;
+  const MeshLoader& load_;
   std::map<std::string, std::shared_ptr<const TriangleMesh>> meshes_;
 };
 
@@ -188,11 +189,18 @@ Status check_top_level(const nlohmann::json& doc) {
 }  // namespace
 
 Result<std::vector<ScriptEdit>> read_edit_script(const std::string& path) {
-  Result<nlohmann::json> doc = read_json_file(path);
+  Result<std::string> text = read_text_file(path);
+  if (!text.ok()) return text.status();
+  return read_edit_script_text(text.value(), path, [](const std::string& mesh) { return load_mesh(mesh); });
+}
+
+Result<std::vector<ScriptEdit>> read_edit_script_text(std::string_view text, const std::string& path,
+                                                      const MeshLoader& load) {
+  Result<nlohmann::json> doc = parse_json_text(text, path);
   if (!doc.ok()) return doc.status();
   Status s = check_top_level(doc.value());
   if (!s.ok()) return Status(s.code(), path + ": " + s.message());
-  MeshFiles files(std::filesystem::path(path).parent_path());
+  MeshFiles files(std::filesystem::path(path).parent_path(), load);
   const nlohmann::json& list = doc.value().at("edits");
   std::vector<ScriptEdit> edits;
   for (size_t i = 0; i < list.size(); ++i) {

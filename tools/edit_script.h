@@ -18,7 +18,9 @@
 // script is read, so a bad script fails before the world is touched.
 #pragma once
 
+#include <functional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "csg/csg.h"
@@ -37,5 +39,13 @@ struct ScriptEdit {
 // Reads and checks a script; mesh brushes' files are loaded (relative paths
 // are taken from the script's folder).
 Result<std::vector<ScriptEdit>> read_edit_script(const std::string& path);
+
+// Loads a mesh brush's file, its path already resolved against the script's folder.
+using MeshLoader = std::function<Result<TriangleMesh>(const std::string& path)>;
+// The same from the script's text: `path` names it in messages and gives the
+// folder of relative mesh files; `load` reads them (tests and the fuzzer pass
+// one that touches no file).
+Result<std::vector<ScriptEdit>> read_edit_script_text(std::string_view text, const std::string& path,
+                                                      const MeshLoader& load);
 
 }  // namespace ldc::tool

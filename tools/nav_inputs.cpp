@@ -7,8 +7,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "common.h"
 #include "json_fields.h"
+#include "json_inputs.h"
 
 namespace ldc::tool {
 
@@ -73,7 +73,14 @@ bool FilterFile::excludes() const {
 }
 
 Result<FilterFile> read_filter_file(const std::string& path) {
-  Result<Json> doc = read_ordered_json_file(path, kNavInputMaxBytes);
+  Result<std::string> text = read_text_file(path, kNavInputMaxBytes);
+  if (!text.ok()) return text.status();
+  return read_filter_text(text.value(), path);
+}
+
+Result<FilterFile> read_filter_text(std::string_view text, const std::string& path) {
+  if (Status s = check_text_size(text, path, kNavInputMaxBytes); !s.ok()) return s;
+  Result<Json> doc = parse_ordered_json_text(text, path);
   if (!doc.ok()) return doc.status();
   const Json& top = doc.value();
   if (!top.is_object()) {
@@ -171,7 +178,14 @@ Result<ResolvedFilter> resolve_filter(const FilterFile& file, const World& world
 }
 
 Result<LinksFile> read_links_file(const std::string& path) {
-  Result<Json> doc = read_ordered_json_file(path, kNavInputMaxBytes);
+  Result<std::string> text = read_text_file(path, kNavInputMaxBytes);
+  if (!text.ok()) return text.status();
+  return read_links_text(text.value(), path);
+}
+
+Result<LinksFile> read_links_text(std::string_view text, const std::string& path) {
+  if (Status s = check_text_size(text, path, kNavInputMaxBytes); !s.ok()) return s;
+  Result<Json> doc = parse_ordered_json_text(text, path);
   if (!doc.ok()) return doc.status();
   const Json& top = doc.value();
   if (!top.is_object()) {

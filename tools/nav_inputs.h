@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "ldc/status.h"
@@ -51,6 +52,8 @@ struct FilterFile {
 };
 
 Result<FilterFile> read_filter_file(const std::string& path);
+// The same from the file's text (`path` names it in messages), for tests and the fuzzer.
+Result<FilterFile> read_filter_text(std::string_view text, const std::string& path);
 
 // A filter file applied to a world: each material named gets its own area
 // (1, 2, ... in the file's order; every other material stays in area 0,
@@ -73,6 +76,7 @@ struct LinksFile {
 // Reads the links; the library checks the rest (radius, finite ends) when
 // they are added (prefix its message with link_context).
 Result<LinksFile> read_links_file(const std::string& path);
+Result<LinksFile> read_links_text(std::string_view text, const std::string& path);
 std::string link_context(const LinksFile& file, size_t index);
 
 }  // namespace ldc::tool
