@@ -218,11 +218,14 @@ int run_raycast(const RaycastArgs& a, const CommonOptions& common) {
     if (!common.json) print_summary(stderr, summary, hits);
     return 0;
   }
-  std::FILE* f = std::fopen(a.output.c_str(), "wb");
-  if (!f) return fail("raycast", "-o " + a.output + ": cannot open for writing");
-  bool ok = write_hits(f, summary, src.value(), hits);
-  ok = (std::fclose(f) == 0) && ok;
-  if (!ok) return fail("raycast", "-o " + a.output + ": write failed");
+  // Streamed into a temp file renamed over -o only once whole (ldc/io.h):
+  // a failure or a kill leaves any previous file as it was.
+  Result<AtomicFile> out = AtomicFile::create(a.output);
+  if (!out.ok()) return fail("raycast", "-o " + out.status().message());
+  if (!write_hits(out.value().stream(), summary, src.value(), hits)) {
+    return fail("raycast", "-o " + a.output + ": write failed");
+  }
+  if (Status s = out.value().commit(); !s.ok()) return fail("raycast", "-o " + s.message());
   if (common.json) {
     nlohmann::json report = {{"ok", true}, {"output", a.output}, {"summary", summary}};
     std::printf("%s\n", json_text(report).c_str());
