@@ -20,13 +20,52 @@ Status io_error(const std::string& path, const std::string& what, int error) {
 
 }  // namespace
 
+namespace {
+
+// "a FIFO", "a folder", ...: what a path that is not a regular file is.
+const char* kind_of(mode_t mode) {
+  return S_ISDIR(mode)    ? "a folder"
+         : S_ISLNK(mode)  ? "a symbolic link"
+         : S_ISFIFO(mode) ? "a FIFO"
+         : S_ISSOCK(mode) ? "a socket"
+                          : "a device";
+}
+
+}  // namespace
+
 Result<std::string> read_file(const std::string& path, uint64_t max_bytes) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (!file) return io_error(path, "cannot open", errno);
+  // O_NONBLOCK: opening a FIFO with no writer would otherwise wait for one
+  // for ever. Only regular files are read (a device such as /dev/zero never
+  // ends), and the size is checked before a byte is read.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return io_error(path, "cannot open", errno);
+  struct stat st;
+  if (::fstat(fd, &st) != 0) {
+    const int error = errno;
+    ::close(fd);
+    return io_error(path, "cannot read", error);
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    return Status(ErrorCode::kIoError, path + ": cannot read: it is " + std::string(kind_of(st.st_mode)) +
+                                           ", not a regular file");
+  }
+  if (uint64_t(st.st_size) > max_bytes) {
+    ::close(fd);
+    return Status(ErrorCode::kTooLarge, path + ": larger than the load limit (" + std::to_string(max_bytes) + " bytes)");
+  }
+  std::FILE* file = ::fdopen(fd, "rb");
+  if (!file) {
+    const int error = errno;
+    ::close(fd);
+    return io_error(path, "cannot open", error);
+  }
   std::string bytes;
   char buffer[1 << 16];
   size_t got = 0;
   try {
+    bytes.reserve(size_t(st.st_size));
+    // Still bounded while reading: a file can grow after the fstat.
     while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) {
       if (bytes.size() + got > max_bytes) {
         std::fclose(file);
@@ -58,12 +97,7 @@ Status check_target(const std::string& path) {
     return io_error(path, "cannot write", errno);
   }
   if (S_ISREG(st.st_mode)) return {};
-  const char* kind = S_ISDIR(st.st_mode)    ? "a folder"
-                     : S_ISLNK(st.st_mode)  ? "a symbolic link"
-                     : S_ISFIFO(st.st_mode) ? "a FIFO"
-                     : S_ISSOCK(st.st_mode) ? "a socket"
-                                            : "a device";
-  return {ErrorCode::kIoError, path + ": cannot write: it is " + std::string(kind) + ", not a regular file"};
+  return {ErrorCode::kIoError, path + ": cannot write: it is " + std::string(kind_of(st.st_mode)) + ", not a regular file"};
 }
 
 // "<folder>/.<name>.XXXXXX": hidden, in the target's folder (so the rename

@@ -69,7 +69,9 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
 // --- Whole files: what every ldc file (worlds, meshes, images) goes through ---
 
 // Reads the whole file. One larger than max_bytes is refused (kTooLarge)
-// before more than that is read; errors name the path and the system's reason.
+// before any of it is read; so is anything but a regular file (a folder, a
+// FIFO, which would block, or a device such as /dev/zero, which never
+// ends). Errors name the path and the system's reason.
 Result<std::string> read_file(const std::string& path, uint64_t max_bytes = UINT64_MAX);
 
 // Writes `bytes` to `path` so that readers see the old file or the whole

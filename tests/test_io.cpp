@@ -287,5 +287,30 @@ TEST(AtomicWrite, AWriterKilledAtRandomMomentsLeavesTheOldOrTheNewFileWhole) {
   fs::remove_all(folder);
 }
 
+// read_file, which every world, mesh and tool input goes through: a FIFO
+// blocked the open for ever, and /dev/zero was read until memory ran out.
+TEST(ReadFile, FifosDevicesAndFoldersAreRefusedWithoutBlocking) {
+  const std::string folder = fresh_folder("read_kinds");
+  const std::string fifo = folder + "/world.ldc";
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  for (auto [path, kind] : {std::pair{fifo, "a FIFO"}, std::pair{std::string("/dev/zero"), "a device"},
+                            std::pair{folder, "a folder"}}) {
+    Result<std::string> r = read_file(path);
+    ASSERT_FALSE(r.ok()) << path;
+    EXPECT_EQ(r.status().code(), ErrorCode::kIoError);
+    EXPECT_EQ(r.status().message(), path + ": cannot read: it is " + kind + ", not a regular file");
+  }
+  EXPECT_FALSE(load_world(fifo).ok());
+}
+
+TEST(ReadFile, AFileOverTheLimitIsRefusedByItsSize) {
+  const std::string folder = fresh_folder("read_limit");
+  ASSERT_TRUE(write_file_atomically(folder + "/big", std::string(1000, 'x')).ok());
+  Result<std::string> r = read_file(folder + "/big", 999);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kTooLarge);
+  EXPECT_EQ(read_file(folder + "/big", 1000).value().size(), 1000u);
+}
+
 }  // namespace
 }  // namespace ldc

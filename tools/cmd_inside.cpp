@@ -24,8 +24,9 @@ int run_inside(const InsideArgs& a, const CommonOptions& common) {
   if (!w.ok()) return fail("inside", w.status());
   Result<std::vector<glm::dvec3>> pts = [&]() -> Result<std::vector<glm::dvec3>> {
     if (a.points.empty()) return read_points(std::cin, "<stdin>");
-    std::ifstream f(a.points);
-    if (!f) return Status(ErrorCode::kIoError, a.points + ": cannot open");
+    Result<std::string> text = read_file(a.points);  // refuses FIFOs and devices, which would block or never end
+    if (!text.ok()) return text.status();
+    std::istringstream f(text.value());
     return read_points(f, a.points);
   }();
   if (!pts.ok()) return fail("inside", pts.status());

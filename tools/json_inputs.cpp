@@ -1,5 +1,7 @@
 #include "json_inputs.h"
 
+#include "ldc/io.h"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -155,21 +157,11 @@ Result<Ray> read_ray(const nlohmann::json& r, const std::string& where) {
 }  // namespace
 
 Result<std::string> read_text_file(const std::string& path, size_t max_bytes) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) return Status(ErrorCode::kIoError, path + ": cannot open: a directory");
-  std::ifstream f(path, std::ios::binary);
-  if (!f) return Status(ErrorCode::kIoError, path + ": cannot open");
-  std::string text;
-  if (max_bytes == 0) {
-    std::ostringstream all;
-    all << f.rdbuf();
-    return std::move(all).str();
+  // ldc::read_file refuses folders, FIFOs and devices, and checks the size first.
+  Result<std::string> text = read_file(path, max_bytes == 0 ? UINT64_MAX : uint64_t(max_bytes));
+  if (!text.ok() && text.status().code() == ErrorCode::kTooLarge) {
+    return Status(ErrorCode::kTooLarge, path + ": over the limit of " + std::to_string(max_bytes) + " bytes for this file");
   }
-  // One byte past the limit says whether the file is over it, without reading it all.
-  text.resize(max_bytes + 1);
-  f.read(text.data(), std::streamsize(text.size()));
-  text.resize(size_t(f.gcount()));
-  if (Status s = check_text_size(text, path, max_bytes); !s.ok()) return s;
   return text;
 }
 
