@@ -1,8 +1,11 @@
 // Small scenes for the GI tests (CPU and Vulkan): unions of boxes on a
 // lattice of h = 0.1 m with its origin at 0, so that 0.2 m voxels have
-// their faces on multiples of 0.2 m.
+// their faces on multiples of 0.2 m; and a ball over the ground (implicit)
+// for the path tracer's view-factor test.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -77,6 +80,45 @@ inline std::vector<GiBox> closed_room(uint16_t wall_material = 0) {
   return {{{-b, -b, -b}, {b, b, -a}, wall_material}, {{-b, -b, a}, {b, b, b}, wall_material},
           {{-b, -b, -b}, {-a, b, b}, wall_material}, {{a, -b, -b}, {b, b, b}, wall_material},
           {{-b, -b, -b}, {b, -a, b}, wall_material}, {{-b, a, -b}, {b, b, b}, wall_material}};
+}
+
+}  // namespace ldc::test
+
+namespace ldc::test {
+
+// A ball of radius r centred at `centre` above a slab whose top is z = 0
+// (x, y in [-half, half], 0.3 m thick), both of one material: an implicit
+// solid, so the ball's crossings are its exact roots.
+class BallOverGround : public ImplicitSolid {
+ public:
+  BallOverGround(const glm::dvec3& centre, double r, double half, uint16_t material)
+      : centre_(centre), r_(r), half_(half), material_(material) {}
+  double value(const glm::dvec3& p) const override {
+    const double slab = std::max({p.z, -0.3 - p.z, std::abs(p.x) - half_, std::abs(p.y) - half_});
+    return std::min(slab, glm::length(p - centre_) - r_);
+  }
+  uint16_t material(const glm::dvec3&) const override { return material_; }
+  WorldBox bounds() const override {
+    return {glm::min(glm::dvec3(-half_, -half_, -0.3), centre_ - r_),
+            glm::max(glm::dvec3(half_, half_, 0.0), centre_ + r_)};
+  }
+
+ private:
+  glm::dvec3 centre_;
+  double r_, half_;
+  uint16_t material_;
+};
+
+// The ball over the ground built on a lattice of cell size h whose planes miss
+// z = 0 (origin offset by a fraction of a cell), so that no node lies on the ground.
+inline World build_ball_over_ground(const glm::dvec3& centre, double r, double half, double h, uint16_t material) {
+  GridConfig grid;
+  grid.cell_size = h;
+  grid.use_origin = true;
+  grid.origin = glm::dvec3(0.31, 0.17, 0.43) * h;
+  Result<World> w = build_from_implicit(BallOverGround(centre, r, half, material), grid);
+  EXPECT_TRUE(w.ok()) << w.status().message();
+  return std::move(w).value();
 }
 
 }  // namespace ldc::test
