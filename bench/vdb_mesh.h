@@ -1,6 +1,7 @@
 // The OpenVDB peer's mesh <-> level-set conversions, shared by bench_contour
 // and bench_csg so that both measure the same pipeline: meshToLevelSet (half
-// width 3 voxels) and volumeToMesh (isovalue 0, adaptivity 0).
+// width 3 voxels) and volumeToMesh (isovalue 0, adaptivity 0 unless given:
+// bench_contour's adaptive table sweeps it).
 #pragma once
 
 #include <vector>
@@ -24,11 +25,11 @@ inline openvdb::FloatGrid::Ptr vdb_level_set(const TriangleMesh& m, const openvd
   return openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(xform, points, tris, no_quads, 3.0f);
 }
 
-inline TriangleMesh vdb_to_mesh(const openvdb::FloatGrid& grid) {
+inline TriangleMesh vdb_to_mesh(const openvdb::FloatGrid& grid, double adaptivity = 0.0) {
   std::vector<openvdb::Vec3s> out_points;
   std::vector<openvdb::Vec3I> out_tris;
   std::vector<openvdb::Vec4I> out_quads;
-  openvdb::tools::volumeToMesh(grid, out_points, out_tris, out_quads, 0.0, 0.0);
+  openvdb::tools::volumeToMesh(grid, out_points, out_tris, out_quads, 0.0, adaptivity);
   TriangleMesh out;
   out.positions.reserve(out_points.size());
   out.triangles.reserve(out_tris.size() + 2 * out_quads.size());
