@@ -225,7 +225,7 @@ int run_raycast(const RaycastArgs& a, const CommonOptions& common) {
   if (!write_hits(out.value().stream(), summary, src.value(), hits)) {
     return fail("raycast", "-o " + a.output + ": write failed");
   }
-  if (Status s = out.value().commit(); !s.ok()) return fail("raycast", "-o " + s.message());
+  if (Status committed = out.value().commit(); !committed.ok()) return fail("raycast", "-o " + committed.message());
   if (common.json) {
     nlohmann::json report = {{"ok", true}, {"output", a.output}, {"summary", summary}};
     std::printf("%s\n", json_text(report).c_str());

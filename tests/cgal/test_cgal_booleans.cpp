@@ -20,6 +20,7 @@
 #include <CGAL/Polygon_mesh_processing/measure.h>
 #include <CGAL/Surface_mesh.h>
 
+#include "cgal/cgal_mesh.h"
 #include "cgal/cgal_validity.h"
 #include "contour/contour.h"
 #include "csg/csg.h"
@@ -31,16 +32,9 @@ namespace ldc {
 namespace {
 
 using Point = CGAL::Exact_predicates_inexact_constructions_kernel::Point_3;
-using Mesh = CGAL::Surface_mesh<Point>;
+using Mesh = test::CgalMesh;
 namespace PMP = CGAL::Polygon_mesh_processing;
-
-Mesh to_cgal(const TriangleMesh& m) {
-  Mesh out;
-  std::vector<Mesh::Vertex_index> v;
-  for (const auto& p : m.positions) v.push_back(out.add_vertex(Point(p.x, p.y, p.z)));
-  for (const auto& t : m.triangles) out.add_face(v[t[0]], v[t[1]], v[t[2]]);
-  return out;
-}
+using test::to_cgal;
 
 TriangleMesh from_cgal(const Mesh& m) {
   TriangleMesh out;

@@ -15,6 +15,7 @@
 #include <CGAL/Surface_mesh.h>
 
 #include "ldc/build.h"
+#include "cgal/cgal_mesh.h"
 #include "test_util.h"
 
 namespace ldc {
@@ -22,16 +23,9 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using Point = Kernel::Point_3;
-using Mesh = CGAL::Surface_mesh<Point>;
+using Mesh = test::CgalMesh;
 namespace PMP = CGAL::Polygon_mesh_processing;
-
-Mesh to_cgal(const TriangleMesh& m) {
-  Mesh out;
-  std::vector<Mesh::Vertex_index> v;
-  for (const auto& p : m.positions) v.push_back(out.add_vertex(Point(p.x, p.y, p.z)));
-  for (const auto& t : m.triangles) out.add_face(v[t[0]], v[t[1]], v[t[2]]);
-  return out;
-}
+using test::to_cgal;
 
 // At least 100,000 random lattice nodes inside the mesh's bounding box, leaving
 // out those within 1e-6 of the diagonal from the surface.
