@@ -72,6 +72,11 @@ cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')
     echo "(bench_gi not built: needs LDC_WITH_VULKAN and Embree)"
   fi
   echo "Finished: $(date -u '+%Y-%m-%d %H:%M UTC'), load average $(load)."
+  # GI on a GPU comes from its own recorded runs on lent machines (this machine has none).
+  if [ -f docs/gpu-runs.md ]; then
+    echo
+    cat docs/gpu-runs.md
+  fi
 } > docs/benchmarks.md.tmp
 mv docs/benchmarks.md.tmp docs/benchmarks.md
 echo "wrote docs/benchmarks.md"
