@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstring>
 #include <new>
+#include <utility>
 
 #include "ldc/io.h"
 
@@ -18,10 +19,6 @@ Status io_error(const std::string& path, const std::string& what, int error) {
   return {ErrorCode::kIoError, path + ": " + what + ": " + std::strerror(error)};
 }
 
-}  // namespace
-
-namespace {
-
 // "a FIFO", "a folder", ...: what a path that is not a regular file is.
 const char* kind_of(mode_t mode) {
   return S_ISDIR(mode)    ? "a folder"
@@ -29,6 +26,10 @@ const char* kind_of(mode_t mode) {
          : S_ISFIFO(mode) ? "a FIFO"
          : S_ISSOCK(mode) ? "a socket"
                           : "a device";
+}
+
+Status over_load_limit(const std::string& path, uint64_t max_bytes) {
+  return {ErrorCode::kTooLarge, path + ": larger than the load limit (" + std::to_string(max_bytes) + " bytes)"};
 }
 
 }  // namespace
@@ -52,7 +53,7 @@ Result<std::string> read_file(const std::string& path, uint64_t max_bytes) {
   }
   if (uint64_t(st.st_size) > max_bytes) {
     ::close(fd);
-    return Status(ErrorCode::kTooLarge, path + ": larger than the load limit (" + std::to_string(max_bytes) + " bytes)");
+    return over_load_limit(path, max_bytes);
   }
   std::FILE* file = ::fdopen(fd, "rb");
   if (!file) {
@@ -69,8 +70,7 @@ Result<std::string> read_file(const std::string& path, uint64_t max_bytes) {
     while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) {
       if (bytes.size() + got > max_bytes) {
         std::fclose(file);
-        return Status(ErrorCode::kTooLarge, path + ": larger than the load limit (" + std::to_string(max_bytes) +
-                                                " bytes)");
+        return over_load_limit(path, max_bytes);
       }
       bytes.append(buffer, got);
     }
@@ -156,22 +156,19 @@ Result<AtomicFile> AtomicFile::create(const std::string& path) {
   return AtomicFile(path, std::move(tmp), stream);
 }
 
+// A moved-from AtomicFile owns no temp file and no stream, so its
+// destructor removes nothing.
 AtomicFile::AtomicFile(AtomicFile&& other) noexcept
-    : path_(std::move(other.path_)), temp_(std::move(other.temp_)), stream_(other.stream_),
-      stream_failed_(other.stream_failed_) {
-  other.stream_ = nullptr;
-  other.temp_.clear();
-}
+    : path_(std::move(other.path_)), temp_(std::exchange(other.temp_, {})),
+      stream_(std::exchange(other.stream_, nullptr)), stream_failed_(other.stream_failed_) {}
 
 AtomicFile& AtomicFile::operator=(AtomicFile&& other) noexcept {
   if (this != &other) {
     discard();
     path_ = std::move(other.path_);
-    temp_ = std::move(other.temp_);
-    stream_ = other.stream_;
+    temp_ = std::exchange(other.temp_, {});
+    stream_ = std::exchange(other.stream_, nullptr);
     stream_failed_ = other.stream_failed_;
-    other.stream_ = nullptr;
-    other.temp_.clear();
   }
   return *this;
 }

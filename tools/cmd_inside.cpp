@@ -1,6 +1,5 @@
 // ldc inside: which points are inside the solid (points from a file or stdin, JSON out).
 #include <cstdio>
-#include <fstream>
 #include <iostream>
 #include <memory>
 #include <sstream>

@@ -1,7 +1,6 @@
 // ldc raycast: first hits of rays (from a JSON file, a camera or one ray) -> JSON.
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <sstream>
 #include <vector>
@@ -41,13 +40,6 @@ struct RaycastArgs {
 
 // Limit on camera rays: the JSON output takes ~150 bytes a ray.
 constexpr size_t kMaxCameraRays = size_t(1) << 24;
-
-std::string number_text(double d) {
-  std::ostringstream s;
-  s.precision(10);
-  s << d;
-  return s.str();
-}
 
 struct RaySource {
   std::vector<Ray> rays;

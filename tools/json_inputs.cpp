@@ -1,17 +1,18 @@
 #include "json_inputs.h"
 
-#include "ldc/io.h"
-
 #include <algorithm>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 
 #include "ldc/internal/vec_text.h"
+#include "ldc/io.h"
 
 namespace ldc::tool {
 namespace {
+
+Status over_size_limit(const std::string& path, size_t max_bytes) {
+  return Status(ErrorCode::kTooLarge, path + ": over the limit of " + std::to_string(max_bytes) + " bytes for this file");
+}
 
 // The deepest nesting of [ and { outside strings, counted up to one past
 // `limit` (the parse finds any other fault).
@@ -83,13 +84,6 @@ Result<std::vector<glm::dvec3>> overlay_points(const nlohmann::json& list, const
 
 // ---- the rays (ldc raycast --rays) -----------------------------------------
 
-std::string number_text(double d) {
-  std::ostringstream s;
-  s.precision(10);
-  s << d;
-  return s.str();
-}
-
 // The checks Queries::ray_cast makes, with the ray's index and field named.
 Status check_ray_fields(const Ray& r, const std::string& where) {
   if (!detail::is_finite(r.origin)) return {ErrorCode::kInvalidArgument, where + "field 'origin' must hold finite numbers"};
@@ -156,18 +150,22 @@ Result<Ray> read_ray(const nlohmann::json& r, const std::string& where) {
 
 }  // namespace
 
+std::string number_text(double d) {
+  std::ostringstream s;
+  s.precision(10);
+  s << d;
+  return s.str();
+}
+
 Result<std::string> read_text_file(const std::string& path, size_t max_bytes) {
   // ldc::read_file refuses folders, FIFOs and devices, and checks the size first.
   Result<std::string> text = read_file(path, max_bytes == 0 ? UINT64_MAX : uint64_t(max_bytes));
-  if (!text.ok() && text.status().code() == ErrorCode::kTooLarge) {
-    return Status(ErrorCode::kTooLarge, path + ": over the limit of " + std::to_string(max_bytes) + " bytes for this file");
-  }
+  if (!text.ok() && text.status().code() == ErrorCode::kTooLarge) return over_size_limit(path, max_bytes);
   return text;
 }
 
 Status check_text_size(std::string_view text, const std::string& path, size_t max_bytes) {
-  if (text.size() <= max_bytes) return {};
-  return Status(ErrorCode::kTooLarge, path + ": over the limit of " + std::to_string(max_bytes) + " bytes for this file");
+  return text.size() <= max_bytes ? Status{} : over_size_limit(path, max_bytes);
 }
 
 Result<nlohmann::json> parse_json_text(std::string_view text, const std::string& name) {

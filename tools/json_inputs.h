@@ -20,6 +20,9 @@
 
 namespace ldc::tool {
 
+// A number in an error message: up to 10 significant digits.
+std::string number_text(double d);
+
 // The whole file; errors name it. A file over max_bytes (0: no limit) is
 // refused (kTooLarge) without reading it whole.
 Result<std::string> read_text_file(const std::string& path, size_t max_bytes = 0);

@@ -66,6 +66,12 @@ std::optional<uint16_t> decimal_id(const std::string& key) {
   return uint16_t(id);
 }
 
+// Both nav inputs: at most kNavInputMaxBytes of JSON, keys kept in order.
+Result<Json> parse_nav_input(std::string_view text, const std::string& path) {
+  if (Status s = check_text_size(text, path, kNavInputMaxBytes); !s.ok()) return s;
+  return parse_ordered_json_text(text, path);
+}
+
 }  // namespace
 
 bool FilterFile::excludes() const {
@@ -79,8 +85,7 @@ Result<FilterFile> read_filter_file(const std::string& path) {
 }
 
 Result<FilterFile> read_filter_text(std::string_view text, const std::string& path) {
-  if (Status s = check_text_size(text, path, kNavInputMaxBytes); !s.ok()) return s;
-  Result<Json> doc = parse_ordered_json_text(text, path);
+  Result<Json> doc = parse_nav_input(text, path);
   if (!doc.ok()) return doc.status();
   const Json& top = doc.value();
   if (!top.is_object()) {
@@ -184,8 +189,7 @@ Result<LinksFile> read_links_file(const std::string& path) {
 }
 
 Result<LinksFile> read_links_text(std::string_view text, const std::string& path) {
-  if (Status s = check_text_size(text, path, kNavInputMaxBytes); !s.ok()) return s;
-  Result<Json> doc = parse_ordered_json_text(text, path);
+  Result<Json> doc = parse_nav_input(text, path);
   if (!doc.ok()) return doc.status();
   const Json& top = doc.value();
   if (!top.is_object()) {
