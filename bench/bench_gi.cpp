@@ -10,7 +10,9 @@
 // the cone-traced irradiance against the path-traced reference (Embree on
 // the contoured mesh) at the same points, for 1, 2 and 3 bounces.
 // Usage: bench_gi [points (200)] [paths per point (512)] [sources: only the
-// error split by light source | timing: only medians of full updates]
+// error split by light source | timing: only medians of full updates |
+// images [DIR]: only whole images against the path tracer (gi_images.cpp),
+// paths per pixel, PNGs into DIR]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,6 +23,7 @@
 #include <vector>
 
 #include "contour/contour.h"
+#include "gi_images.h"
 #include "csg/csg.h"
 #include "gi_bridge/gi.h"
 #include "gi_bridge/path_trace.h"
@@ -367,6 +370,10 @@ int main(int argc, char** argv) {
     timing(cornell());
     timing(landscape());
     timing(shared_mesh());
+    return 0;
+  }
+  if (argc > 3 && std::string(argv[3]) == "images") {
+    ldc::bench::gi_images(paths, argc > 4 ? argv[4] : nullptr, true);
     return 0;
   }
   if (argc > 3 && std::string(argv[3]) == "sources") {

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "gi_bridge/detail/gi_engine.h"
+#include "ldc/world.h"
 #include "ldc/internal/vec_text.h"
 
 namespace ldc {
@@ -81,6 +82,19 @@ Status check_gi_lights(const GiLights& lights, const GiConfig& config) {
       return bad("point light " + std::to_string(i) + ": position must be finite and intensity finite and >= 0");
   }
   return {};
+}
+
+std::vector<size_t> remove_buried_lights(const World& world, GiLights* lights) {
+  std::vector<size_t> buried;
+  std::vector<PointLight> kept;
+  for (size_t i = 0; i < lights->points.size(); ++i) {
+    if (world.inside(lights->points[i].position))
+      buried.push_back(i);
+    else
+      kept.push_back(lights->points[i]);
+  }
+  lights->points = std::move(kept);
+  return buried;
 }
 
 Status check_gi_config(const GiConfig& config) {

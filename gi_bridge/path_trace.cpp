@@ -5,6 +5,8 @@
 #include <numbers>
 #include <limits>
 #include <random>
+#include <string>
+#include <vector>
 
 #include <embree3/rtcore.h>
 #include <tbb/parallel_for.h>
@@ -183,6 +185,42 @@ Status PathTracer::irradiance(std::span<const glm::dvec3> points, std::span<cons
     }
     out[q] = sum * (std::numbers::pi_v<float> / float(config.samples)) + point_light_irradiance(im, points[q], p0, n0);
   });
+  return {};
+}
+
+}  // namespace ldc
+
+namespace ldc {
+
+Status PathTracer::radiance_along(std::span<const Ray> rays, int bounces, std::span<glm::vec3> out,
+                                  const PathTraceConfig& config, std::span<uint8_t> hit) const {
+  if (out.size() != rays.size() || (!hit.empty() && hit.size() != rays.size()))
+    return Status(ErrorCode::kInvalidArgument, "path tracer: " + std::to_string(rays.size()) + " rays but " +
+                                                   std::to_string(out.size()) + " outputs");
+  const Impl& im = *impl_;
+  std::vector<glm::dvec3> points;
+  std::vector<glm::vec3> normals;
+  std::vector<size_t> pixel;
+  std::vector<uint16_t> material;
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const glm::vec3 d = glm::normalize(glm::vec3(rays[i].direction));
+    const Hit h = intersect(rays[i].origin, d);
+    if (!hit.empty()) hit[i] = std::isfinite(h.distance) ? 1 : 0;
+    if (!std::isfinite(h.distance)) {
+      out[i] = im.lights.sky.radiance(d);
+      continue;
+    }
+    points.push_back(rays[i].origin + h.distance * glm::dvec3(d));
+    normals.push_back(h.normal);
+    pixel.push_back(i);
+    material.push_back(h.material);
+  }
+  std::vector<glm::vec3> e(points.size());
+  if (Status s = irradiance(points, normals, bounces, e, config); !s.ok()) return s;
+  for (size_t k = 0; k < pixel.size(); ++k) {
+    const VoxelMaterial& m = im.materials[material[k]];
+    out[pixel[k]] = m.albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + m.emission;
+  }
   return {};
 }
 

@@ -23,6 +23,7 @@
 
 #include "contour/contour.h"
 #include "gi_bridge/gi.h"
+#include "ldc/query.h"
 
 namespace ldc {
 
@@ -50,6 +51,13 @@ class PathTracer {
     uint16_t material;
   };
   Hit intersect(const glm::dvec3& origin, const glm::vec3& direction) const;
+
+  // What a camera sees along each ray (one per pixel, say): the sky's
+  // radiance where it misses; albedo / pi * irradiance + emission of the
+  // first surface it hits, the irradiance path-traced as irradiance() does.
+  // `hit` (optional) receives 1 where the ray hit a surface, 0 where not.
+  Status radiance_along(std::span<const Ray> rays, int bounces, std::span<glm::vec3> out,
+                        const PathTraceConfig& config = {}, std::span<uint8_t> hit = {}) const;
 
   struct Impl;
 

@@ -1,0 +1,267 @@
+// `bench_gi 0 PATHS images [DIR]` (issue 25): the cone tracer's images
+// against the path tracer's, whole images rather than points near the
+// camera. Per view and engine (CPU; Vulkan where a device exists), over the
+// pixels whose camera ray hits the contoured mesh, in linear radiance:
+//   rel. L1     = sum |cone - path| / sum path (luminance), all hit pixels,
+//                 and over the darkest fifth of them (by the path tracer);
+//   brightness  = sum cone / sum path.
+// The reference is the mean of two path-traced images of PATHS paths per
+// pixel (seeds 1 and 2); their own rel. L1 against each other says how
+// noisy one of them is. Views where the path tracer sees no light at all
+// (the closed room with the sky outside) report the cone tracer's mean
+// radiance instead, which must be 0. With DIR, each view is written as
+// DIR/gi_<view>.png: the cone tracer (CPU engine) on the left, the
+// reference on the right.
+#include "gi_images.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "contour/contour.h"
+#include "csg/csg.h"
+#include "gi_bridge/path_trace.h"
+#include "ldc/build.h"
+#include "ldc/query.h"
+#include "ldc/terrain.h"
+#include "render/render.h"
+
+namespace ldc::bench {
+namespace {
+
+constexpr int kWidth = 160;
+constexpr int kHeight = 90;
+
+struct View {
+  std::string name;      // also the PNG's name
+  const World* world;
+  glm::dvec3 camera, target;
+  double fov;
+  GiLights lights;
+  MaterialTable materials;
+};
+
+// The main job's world: the default landscape with scripts/default-tunnel.json's
+// edits (a tunnel through it with a chamber, a pillar and a sand floor).
+World main_job_tunnel() {
+  Result<World> w = build_terrain(TerrainConfig{}, 0.2);
+  if (!w.ok()) std::exit(1);
+  WorldEditor ed(std::move(w).value());
+  NoiseSphere chamber;
+  chamber.radius = 2.8;
+  chamber.amplitude = 0.35;
+  chamber.frequency = 1.5;
+  chamber.seed = 3;
+  const std::pair<Brush, EditOp> edits[] = {
+      {Brush::capsule({-1, 9, 3.2}, {12, 10, 3.6}, 1.5), EditOp::kSubtract},
+      {Brush::capsule({12, 10, 3.6}, {24, 9, 3.8}, 1.5), EditOp::kSubtract},
+      {Brush::noisy_sphere({24, 9, 4.2}, chamber), EditOp::kSubtract},
+      {Brush::capsule({24, 9, 3.8}, {36, 11, 3.6}, 1.5), EditOp::kSubtract},
+      {Brush::capsule({36, 11, 3.6}, {49, 10, 3.0}, 1.5), EditOp::kSubtract},
+      {Brush::cylinder({24, 9, 1}, {24, 9, 7.5}, 0.45, 2), EditOp::kUnion},
+      {Brush::capsule({-1, 9.5, 2.0}, {49, 10, 2.0}, 1.4, 3), EditOp::kPaint}};
+  for (const auto& [brush, op] : edits) {
+    if (!ed.apply(brush, op).ok()) std::exit(1);
+  }
+  return ed.world();
+}
+
+void add_box(TriangleMesh& m, glm::dvec3 lo, glm::dvec3 hi, uint16_t mat) {
+  const uint32_t b = uint32_t(m.positions.size());
+  for (int i = 0; i < 8; ++i) m.positions.emplace_back(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
+  const uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& f : q) {
+    m.triangles.emplace_back(b + f[0], b + f[1], b + f[2]);
+    m.triangles.emplace_back(b + f[0], b + f[2], b + f[3]);
+    m.triangle_material.insert(m.triangle_material.end(), {mat, mat});
+  }
+}
+
+// A closed room of 4 x 4 x 3 m inside, walls 0.4 m thick, on a lattice of
+// 0.1 m: thin enough that the coarse levels hold wall and room in one voxel.
+World closed_room() {
+  TriangleMesh m;
+  const double x = 2.0, y = 2.0, z = 1.5, t = 0.4;
+  add_box(m, {-x - t, -y - t, -z - t}, {x + t, y + t, -z}, 0);
+  add_box(m, {-x - t, -y - t, z}, {x + t, y + t, z + t}, 0);
+  add_box(m, {-x - t, -y - t, -z}, {-x, y + t, z}, 1);
+  add_box(m, {x, -y - t, -z}, {x + t, y + t, z}, 2);
+  add_box(m, {-x, -y - t, -z}, {x, -y, z}, 0);
+  add_box(m, {-x, y, -z}, {x, y + t, z}, 0);
+  add_box(m, {-0.6, -0.2, -z}, {0.2, 0.6, -0.7}, 0);  // a block on the floor
+  GridConfig g;
+  g.cell_size = 0.1;
+  g.use_origin = true;
+  Result<World> w = build_from_mesh(m, g);
+  if (!w.ok()) std::exit(1);
+  return std::move(w).value();
+}
+
+MaterialTable room_materials(float emission) {
+  MaterialTable t;
+  t.materials = {{glm::vec3(0.7f), glm::vec3(emission)},
+                 {glm::vec3(0.7f, 0.15f, 0.12f), glm::vec3(emission)},
+                 {glm::vec3(0.15f, 0.7f, 0.15f), glm::vec3(emission)}};
+  return t;
+}
+
+SkyLight default_sky() { return SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f)); }
+
+float lum(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+
+struct ImageError {
+  double l1 = 0, l1_dark = 0, brightness = 0, mean_cone = 0, mean_path = 0;
+};
+
+ImageError compare(const std::vector<glm::vec3>& cone, const std::vector<glm::vec3>& path,
+                   const std::vector<uint8_t>& hit) {
+  std::vector<size_t> px;
+  for (size_t i = 0; i < hit.size(); ++i)
+    if (hit[i]) px.push_back(i);
+  ImageError e;
+  if (px.empty()) return e;
+  std::sort(px.begin(), px.end(), [&](size_t a, size_t b) { return lum(path[a]) < lum(path[b]); });
+  const size_t dark = std::max<size_t>(1, px.size() / 5);
+  double diff = 0, diff_dark = 0, sum_c = 0, sum_p = 0, sum_p_dark = 0;
+  for (size_t k = 0; k < px.size(); ++k) {
+    const double c = lum(cone[px[k]]), p = lum(path[px[k]]);
+    diff += std::abs(c - p), sum_c += c, sum_p += p;
+    if (k < dark) diff_dark += std::abs(c - p), sum_p_dark += p;
+  }
+  e.l1 = sum_p > 0 ? diff / sum_p : 0;
+  e.l1_dark = sum_p_dark > 0 ? diff_dark / sum_p_dark : 0;
+  e.brightness = sum_p > 0 ? sum_c / sum_p : 0;
+  e.mean_cone = sum_c / double(px.size());
+  e.mean_path = sum_p / double(px.size());
+  return e;
+}
+
+void print_row(const View& v, const std::string& engine, const ImageError& e, double noise, int paths) {
+  if (e.mean_path <= 0.0) {
+    std::printf("| %s | %s | — | — | — | mean %.2e (path %.2e) | %d x 2 |\n", v.name.c_str(), engine.c_str(),
+                e.mean_cone, e.mean_path, paths);
+    return;
+  }
+  std::printf("| %s | %s | %.3f | %.3f | %.3f | %.3f | %d x 2 |\n", v.name.c_str(), engine.c_str(), e.l1, e.l1_dark,
+              e.brightness, noise, paths);
+}
+
+struct Reference {
+  std::vector<glm::vec3> mean;
+  std::vector<uint8_t> hit;
+  double noise = 0;  // rel. L1 of seed 2 against seed 1
+};
+
+Result<Reference> reference(const View& v, const std::vector<Ray>& rays, int paths) {
+  Result<ContourMesh> mesh = contour_world(*v.world);
+  if (!mesh.ok()) return mesh.status();
+  Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), v.materials, v.lights);
+  if (!pt.ok()) return pt.status();
+  Reference r;
+  std::vector<glm::vec3> a(rays.size()), b(rays.size());
+  r.hit.resize(rays.size());
+  PathTraceConfig pc;
+  pc.samples = paths;
+  if (Status s = pt.value()->radiance_along(rays, 3, a, pc, r.hit); !s.ok()) return s;
+  pc.seed = 2;
+  if (Status s = pt.value()->radiance_along(rays, 3, b, pc); !s.ok()) return s;
+  r.noise = compare(b, a, r.hit).l1;
+  r.mean.resize(rays.size());
+  for (size_t i = 0; i < rays.size(); ++i) r.mean[i] = 0.5f * (a[i] + b[i]);
+  return r;
+}
+
+// The cone tracer's image of the view (3 passes, 3 bounces), or an error.
+Result<RadianceImage> cone_image(const View& v, const Camera& cam, GiEngine& gi) {
+  CascadeConfig cc;
+  cc.voxel_size = 2.0 * v.world->lattice().cell_size;
+  cc.materials = v.materials;
+  Result<Cascades> cas = Cascades::create(v.world->lattice(), cc);
+  if (!cas.ok()) return cas.status();
+  if (Status s = cas.value().update_all(*v.world, cam.position()); !s.ok()) return s;
+  if (Status s = gi.load(cas.value(), v.lights); !s.ok()) return s;
+  if (Result<GiTimings> t = gi.update_all(3); !t.ok()) return t.status();
+  Queries queries(*v.world);
+  return render_gi(queries, cam, gi, {.materials = v.materials, .sky = v.lights.sky, .bounces = 3});
+}
+
+void run_view(const View& v, int paths, const char* dir, bool with_vulkan) {
+  CameraConfig cc;
+  cc.position = v.camera;
+  cc.target = v.target;
+  cc.fov_degrees = v.fov;
+  cc.width = kWidth;
+  cc.height = kHeight;
+  Result<Camera> cam = Camera::make(cc, v.world);
+  if (!cam.ok()) return;
+  std::vector<Ray> rays;
+  for (int y = 0; y < kHeight; ++y)
+    for (int x = 0; x < kWidth; ++x) rays.push_back(cam.value().pixel_ray(x, y));
+  Result<Reference> ref = reference(v, rays, paths);
+  if (!ref.ok()) {
+    std::printf("| %s | reference failed: %s |\n", v.name.c_str(), ref.status().message().c_str());
+    return;
+  }
+  for (int engine = 0; engine < (with_vulkan ? 2 : 1); ++engine) {
+    std::string device = "cpu";
+    std::unique_ptr<GiEngine> gi;
+    if (engine == 0) {
+      gi = make_cpu_gi();
+    } else {
+      Result<std::unique_ptr<GiEngine>> vk = make_vulkan_gi({}, &device);
+      if (!vk.ok()) continue;
+      gi = std::move(vk).value();
+    }
+    Result<RadianceImage> img = cone_image(v, cam.value(), *gi);
+    if (!img.ok()) {
+      std::printf("| %s | %s | failed: %s |\n", v.name.c_str(), device.c_str(), img.status().message().c_str());
+      continue;
+    }
+    print_row(v, device, compare(img.value().pixels, ref.value().mean, ref.value().hit), ref.value().noise, paths);
+    if (dir && engine == 0) {
+      const RadianceImage path{kWidth, kHeight, ref.value().mean};
+      Result<Image> both = side_by_side(tone_map(img.value(), 1.0f), tone_map(path, 1.0f));
+      if (both.ok()) (void)write_png(both.value(), std::string(dir) + "/gi_" + v.name + ".png");
+    }
+  }
+}
+
+}  // namespace
+
+void gi_images(int paths, const char* dir, bool with_vulkan) {
+  const World tunnel = main_job_tunnel();
+  const World room = closed_room();
+  GiLights sky;
+  sky.sky = default_sky();
+  GiLights chamber_light = sky;
+  chamber_light.points.push_back({glm::dvec3(25.5, 9, 4.2), glm::vec3(3.0f)});
+  GiLights light_only;
+  light_only.points = chamber_light.points;
+  GiLights room_light;
+  room_light.points.push_back({glm::dvec3(0.8, -0.6, 0.9), glm::vec3(3.0f)});
+  const MaterialTable terrain = default_material_table();
+  const View views[] = {
+      {"landscape", &tunnel, {61, -5, 10}, {45, 11, 3.4}, 55, sky, terrain},
+      {"tunnel_near_mouth", &tunnel, {44, 10.4, 3.4}, {37, 11, 3.4}, 70, sky, terrain},
+      {"tunnel_far_from_mouths", &tunnel, {8, 9.8, 3.6}, {14, 10, 3.6}, 70, sky, terrain},
+      {"chamber_sky_and_light", &tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, chamber_light, terrain},
+      {"chamber_light_only", &tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, light_only, terrain},
+      {"chamber_sky_only", &tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, sky, terrain},
+      {"closed_room_light", &room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, room_light, room_materials(0.0f)},
+      {"closed_room_sky_outside", &room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, sky, room_materials(0.0f)},
+      {"furnace", &room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, GiLights{}, room_materials(1.0f)}};
+  std::printf("\n## Whole images against the path tracer (issue 25)\n");
+  std::printf("%d x %d pixels, 3 bounces, cascades of 6 levels of 32^3 voxels of 2 h centred on the camera, 3 passes; "
+              "reference: mean of 2 path-traced images of %d paths per pixel (seeds 1, 2)\n",
+              kWidth, kHeight, paths);
+  std::printf("| view | engine | rel. L1 | rel. L1, darkest fifth | brightness | reference noise (seed 2 vs 1) | paths |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  const char* only = std::getenv("BENCH_GI_VIEW");  // a substring of the views to run (all when unset)
+  for (const View& v : views)
+    if (!only || v.name.find(only) != std::string::npos) run_view(v, paths, dir, with_vulkan);
+}
+
+}  // namespace ldc::bench
