@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include "ldc/internal/build_common.h"
+#include "ldc/internal/lattice_range.h"
 #include "ldc/internal/ray_math.h"
 
 namespace ldc::detail {
@@ -76,6 +77,8 @@ Result<WorldConfig> plan_grid(const WorldBox& b, const GridConfig& grid, double 
     wc.chunk_origin[a] = first;
     wc.chunk_dims[a] = end - first;
   }
+  // Precision and range: what World::create would refuse, named for this builder.
+  if (Status range = check_lattice_range(wc, what); !range.ok()) return range;
   double slots = double(wc.chunk_dims.x) * wc.chunk_dims.y * wc.chunk_dims.z;
   // ~2 points per unit of surface per axis pair, 8 bytes stored plus ~40 in flight
   // during a build; 64 bytes of table per chunk slot.

@@ -27,30 +27,47 @@ namespace detail {
 // ---------------------------------------------------------------------------
 // Stage 1: snap and weld
 
+namespace {
+
+// Which positions a triangle uses: the others do not size the lattice and are not snapped.
+std::vector<uint8_t> referenced_vertices(const TriangleMesh& mesh) {
+  std::vector<uint8_t> used(mesh.positions.size(), 0);
+  for (const glm::uvec3& t : mesh.triangles)
+    for (int corner = 0; corner < 3; ++corner)
+      if (t[corner] < used.size()) used[t[corner]] = 1;  // check_mesh names bad indices
+  return used;
+}
+
+}  // namespace
+
 Status snap_vertices(const TriangleMesh& mesh, const Lattice& lat, SnappedMesh& out,
                      std::vector<uint32_t>& welded_id) {
   const size_t n = mesh.positions.size();
+  const std::vector<uint8_t> used = referenced_vertices(mesh);
   std::vector<Vec3i> fixed(n);
+  std::vector<uint32_t> order;
+  order.reserve(n);
   const double scale = double(kFixedOne) / lat.cell_size;
   for (size_t i = 0; i < n; ++i) {
+    if (!used[i]) continue;
     for (int a = 0; a < 3; ++a) {
       double f = (mesh.positions[i][a] - lat.origin[a]) * scale;
       if (!std::isfinite(f) || std::abs(f) > double(kMaxNodeCoordinate) * kFixedOne) {
         return {ErrorCode::kInvalidArgument,
-                "mesh: vertex " + std::to_string(i) + " lies outside the lattice range"};
+                "mesh: vertex " + std::to_string(i + 1) + " (1-based) lies outside the lattice range"};
       }
       fixed[i][a] = std::llround(f);
     }
+    order.push_back(uint32_t(i));
   }
-  // Weld: equal fixed-point positions become one vertex.
-  std::vector<uint32_t> order(n);
-  for (size_t i = 0; i < n; ++i) order[i] = uint32_t(i);
+  // Weld: equal fixed-point positions become one vertex. Unused positions
+  // keep welded id 0; no triangle reads it.
   tbb::parallel_sort(order.begin(), order.end(),
                      [&](uint32_t a, uint32_t b) { return fixed[a] < fixed[b]; });
   welded_id.assign(n, 0);
   out.vertices.clear();
   out.unsnapped.clear();
-  for (size_t k = 0; k < n; ++k) {
+  for (size_t k = 0; k < order.size(); ++k) {
     if (k == 0 || fixed[order[k]] != fixed[order[k - 1]]) {
       out.vertices.push_back(fixed[order[k]]);
       out.unsnapped.push_back((mesh.positions[order[k]] - lat.origin) * scale);

@@ -3,11 +3,13 @@
 // segment parameter) and exact normals (inverse-transpose of the local normal).
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <utility>
 
 #include "ldc/build.h"
 #include "ldc/internal/build_common.h"
+#include "ldc/internal/lattice_range.h"
 
 namespace ldc {
 
@@ -187,6 +189,29 @@ class PrimitiveSolid final : public ImplicitSolid {
 
 bool finite_positive(double v) { return v > 0.0 && std::isfinite(v); }
 
+// The primitive's smallest half size in local units (a capsule's segment may be short).
+double smallest_local_size(const Primitive& p) {
+  switch (p.shape) {
+    case Primitive::Shape::kSphere:
+    case Primitive::Shape::kCapsule: return p.radius;
+    case Primitive::Shape::kCylinder: return std::min(p.radius, p.half_height);
+    case Primitive::Shape::kBox: return std::min({p.half_extents.x, p.half_extents.y, p.half_extents.z});
+  }
+  return p.radius;
+}
+
+// Refuses a primitive so small in world units that squares of its sizes
+// underflow: its classification then broke (a 1e-170 sphere built every chunk solid).
+Status check_world_size(const Primitive& p, const glm::dmat3& m) {
+  const double scale = std::min({glm::length(m[0]), glm::length(m[1]), glm::length(m[2])});
+  const double size = smallest_local_size(p) * scale;
+  if (size >= detail::kMinLatticeCellSize) return {};
+  char text[160];
+  std::snprintf(text, sizeof(text), "%s: smallest half size %g m (after the transform) is below the limit of %g m",
+                primitive_shape_name(p.shape), size, detail::kMinLatticeCellSize);
+  return {ErrorCode::kInvalidArgument, text};
+}
+
 }  // namespace
 
 Status check_primitive(const Primitive& p) {
@@ -220,7 +245,7 @@ Status check_primitive(const Primitive& p) {
     return {ErrorCode::kInvalidArgument, name + ": transform is not invertible (det " +
                                              std::to_string(det) + ")"};
   }
-  return {};
+  return check_world_size(p, m);
 }
 
 std::unique_ptr<ImplicitSolid> make_primitive_solid(const Primitive& primitive) {

@@ -5,10 +5,13 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 
+#include "ldc/internal/lattice_range.h"
 #include "ldc/internal/ray_math.h"
+#include "ldc/internal/vec_text.h"
 
 namespace ldc {
 
@@ -200,10 +203,54 @@ Status check_world_config(const WorldConfig& config) {
                                         " chunk slots requested"};
     }
   }
-  return {};
+  return detail::check_lattice_range(config, "world");
+}
+
+// A number as %g, for messages about magnitudes.
+std::string g_text(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%g", x);
+  return buffer;
 }
 
 }  // namespace
+
+namespace detail {
+
+double min_cell_size_at(double magnitude) {
+  const double ulp = std::nextafter(magnitude, INFINITY) - magnitude;
+  return std::max(kMinCellUlps * ulp, kMinLatticeCellSize);
+}
+
+Status check_lattice_range(const WorldConfig& config, std::string_view what) {
+  const std::string prefix = std::string(what) + ": ";
+  const double h = config.lattice.cell_size;
+  const glm::dvec3 node_lo = glm::dvec3(config.chunk_origin) * double(config.chunk_size);
+  const glm::dvec3 node_hi = glm::dvec3(config.chunk_origin + config.chunk_dims) * double(config.chunk_size);
+  const glm::dvec3 lo = config.lattice.origin + h * node_lo, hi = config.lattice.origin + h * node_hi;
+  if (!is_finite(lo) || !is_finite(hi)) {
+    return {ErrorCode::kInvalidArgument, prefix + "the lattice's box " + vec_text(lo) + " .. " + vec_text(hi) +
+                                             " is not finite (cell size " + g_text(h) + " m)"};
+  }
+  const glm::dvec3 reach = glm::max(glm::abs(lo), glm::abs(hi));
+  const double magnitude = std::max(reach.x, std::max(reach.y, reach.z));
+  if (magnitude > kMaxLatticeCoordinate) {
+    return {ErrorCode::kTooLarge, prefix + "the lattice's box " + vec_text(lo) + " .. " + vec_text(hi) +
+                                      " reaches " + g_text(magnitude) + " m, past the limit of " +
+                                      g_text(kMaxLatticeCoordinate) + " m"};
+  }
+  const double least = min_cell_size_at(magnitude);
+  if (h < least) {
+    return {ErrorCode::kInvalidArgument,
+            prefix + "cell size " + g_text(h) + " m is below the limit of " + g_text(least) +
+                " m for coordinates up to " + g_text(magnitude) + " m (" + g_text(kMinCellUlps) +
+                " units in the last place there, and at least " + g_text(kMinLatticeCellSize) +
+                " m): doubles cannot place points within such a cell"};
+  }
+  return {};
+}
+
+}  // namespace detail
 
 void ContentStamp::renew() {
   static std::atomic<uint64_t> next{1};

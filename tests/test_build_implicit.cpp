@@ -131,6 +131,34 @@ TEST(Primitives, BadParametersAreRefused) {
   EXPECT_NE(w.status().message().find("invertible"), std::string::npos);
 }
 
+// Issue 24, item 4: a 1e-170 sphere built every chunk solid (its squared
+// sizes underflow) and wrote a world its own loader refused.
+TEST(Primitives, SizesWhoseSquaresUnderflowAreRefused) {
+  Primitive tiny;
+  tiny.radius = 1e-170;
+  Result<World> w = build_from_primitive(tiny, {});
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.status().message(), "sphere: smallest half size 1e-170 m (after the transform) is below the limit of 1e-100 m");
+  Primitive scaled;  // a unit box scaled below the limit (still invertible in doubles)
+  scaled.shape = Primitive::Shape::kBox;
+  scaled.transform = glm::scale(glm::dmat4(1.0), glm::dvec3(1e-101));
+  EXPECT_EQ(check_primitive(scaled).message(),
+            "box: smallest half size 1e-101 m (after the transform) is below the limit of 1e-100 m");
+}
+
+// A primitive just above that limit still gets a lattice whose cubes
+// underflow at 128 cells: the shared lattice check names the cell size.
+TEST(Primitives, CellsBelowTheSmallestCellSizeAreRefused) {
+  Primitive small;
+  small.radius = 1e-99;
+  Result<World> w = build_from_primitive(small, {.cells = 128});
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.status().message().find("implicit: cell size 1.5625e-101 m is below the limit of 1e-100 m"),
+            std::string::npos)
+      << w.status().message();
+  EXPECT_TRUE(build_from_primitive(small, {.cells = 8}).ok());
+}
+
 TEST(Heightfield, ZRaysCrossAtTheSurfaceHeight) {
   auto f = [](double x, double y) { return 2.0 + 0.5 * std::sin(x) * std::cos(0.7 * y); };
   Heightfield hf = heightfield_from_function(65, 65, 0.25, f, 0.0);

@@ -280,6 +280,41 @@ TEST(MeshBuild, BadInputIsRefusedWithAMessageAndNoWorld) {
   EXPECT_NE(zero.status().message().find("cells = 0"), std::string::npos);
 }
 
+// Issue 24, item 4: a lattice whose cells are a few ulp wide made 94% of a
+// remeshed cube's triangles degenerate (at 1e15 doubles are 0.125 apart).
+TEST(MeshBuild, CellsBelowTheSpacingOfDoublesFarFromTheOriginAreRefused) {
+  const glm::dvec3 far(1e15, 0.0, 0.0);
+  Result<World> w = build_from_mesh(box_mesh(far, far + glm::dvec3(1.0)), {.cell_size = 0.031});
+  ASSERT_FALSE(w.ok());
+  EXPECT_EQ(w.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(w.status().message().find("mesh: cell size 0.031 m is below the limit of 125 m for coordinates up to 1e+15 m"),
+            std::string::npos)
+      << w.status().message();
+  // A cell of 1000 ulp there is fine.
+  EXPECT_TRUE(build_from_mesh(box_mesh(far, far + glm::dvec3(1000.0)), {.cell_size = 125.0}).ok());
+}
+
+TEST(MeshBuild, ALatticeReachingPastTheCoordinateLimitIsRefused) {
+  Result<World> w = build_from_mesh(box_mesh(glm::dvec3(-1e150), glm::dvec3(1e150)), {});
+  ASSERT_FALSE(w.ok());
+  EXPECT_NE(w.status().message().find("past the limit of 1e+100 m"), std::string::npos) << w.status().message();
+}
+
+// Issue 24, item 4: one unused vertex far away failed the build, naming a
+// 0-based index no face uses. Unused positions neither size nor fail it.
+TEST(MeshBuild, AnUnusedFarVertexNeitherSizesNorFailsTheBuild) {
+  const TriangleMesh cube = box_mesh({0, 0, 0}, {1, 1, 1});
+  TriangleMesh stray = cube;
+  stray.positions.push_back(glm::dvec3(1e12, -1e12, 1e12));
+  Result<World> w = build_from_mesh(stray, {.cells = 16});
+  ASSERT_TRUE(w.ok()) << w.status().message();
+  const World plain = build_from_mesh(cube, {.cells = 16}).value();
+  EXPECT_EQ(w.value().lattice().cell_size, plain.lattice().cell_size);
+  EXPECT_EQ(w.value().lattice().origin, plain.lattice().origin);
+  EXPECT_EQ(w.value().stats().points, plain.stats().points);
+  EXPECT_TRUE(is_valid(w.value()));
+}
+
 TEST(MeshBuild, CancelledBuildReturnsCancelled) {
   Context ctx;
   ctx.cancel();

@@ -142,6 +142,30 @@ TEST(LdcFile, HostileHeadersFailWithoutHugeAllocations) {
   EXPECT_FALSE(deserialize_world(with_header_field(bytes, 40, &nan_h, 8), "h").ok());
 }
 
+// Issue 24, item 4: the loader took cell sizes from 5e-324 to 1.7e308 and
+// origins of +-1.7e308, which later gave all-degenerate meshes or infinite
+// coordinates. Each is refused, named, by the check the builders use.
+TEST(LdcFile, HeaderLatticesDoublesCannotCarryAreRefused) {
+  const std::string bytes = as_string(serialize_world(bunny_world()).value());
+  auto load_error = [](const std::string& file, const char* name) {
+    Result<World> w = deserialize_world(file, name);
+    EXPECT_FALSE(w.ok()) << name;
+    EXPECT_EQ(w.status().code(), ErrorCode::kCorruptData) << name;
+    return w.ok() ? std::string() : w.status().message();
+  };
+  const double tiny = 5e-324, huge = 1.7e308, far = 1e15;
+  EXPECT_NE(load_error(with_header_field(bytes, 40, &tiny, 8), "tiny_h")
+                .find("tiny_h: header: world: cell size 4.94066e-324 m is below the limit of "),
+            std::string::npos);
+  EXPECT_NE(load_error(with_header_field(bytes, 40, &huge, 8), "huge_h").find("huge_h: header: world: the lattice's box"),
+            std::string::npos);
+  EXPECT_NE(load_error(with_header_field(bytes, 16, &huge, 8), "huge_origin")
+                .find("reaches 1.7e+308 m, past the limit of 1e+100 m"),
+            std::string::npos);
+  EXPECT_NE(load_error(with_header_field(bytes, 24, &far, 8), "far_origin").find("is below the limit of 125 m"),
+            std::string::npos);
+}
+
 TEST(LdcFile, MutationFuzzNeverCrashesAndAlwaysExplains) {
   std::string bytes = as_string(serialize_world(bunny_world()).value());
   std::mt19937 rng(5);

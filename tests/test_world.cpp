@@ -112,6 +112,43 @@ TEST(WorldConfig, BadValuesAreRefusedWithTheirName) {
   EXPECT_EQ(w.status().code(), ErrorCode::kTooLarge);
 }
 
+// Issue 24, item 4: the range every World keeps, whoever makes it (builders,
+// the loader, an edit growing the box). Each message names value and limit.
+std::string create_error(const WorldConfig& c) {
+  Result<World> w = World::create(c);
+  return w.ok() ? "created" : w.status().message();
+}
+
+TEST(WorldConfig, LatticesDoublesCannotCarryAreRefused) {
+  WorldConfig c;  // h = 0.2, one chunk of 32 cells at the origin
+  EXPECT_EQ(create_error(c), "created");
+  c.lattice.cell_size = 5e-324;
+  EXPECT_NE(create_error(c).find("world: cell size 4.94066e-324 m is below the limit of 1e-100 m"), std::string::npos)
+      << create_error(c);
+  c.lattice.cell_size = 1.7e308;
+  EXPECT_NE(create_error(c).find("world: the lattice's box (0, 0, 0) .. (inf, inf, inf) is not finite"),
+            std::string::npos)
+      << create_error(c);
+  c.lattice.cell_size = 0.2;
+  c.lattice.origin = glm::dvec3(1.7e308, 0.0, 0.0);
+  EXPECT_NE(create_error(c).find("reaches 1.7e+308 m, past the limit of 1e+100 m"), std::string::npos)
+      << create_error(c);
+  c.lattice.origin = glm::dvec3(0.0, 0.0, 1e15);
+  EXPECT_NE(create_error(c).find("world: cell size 0.2 m is below the limit of 125 m for coordinates up to 1e+15 m"),
+            std::string::npos)
+      << create_error(c);
+  c.lattice.cell_size = 125.0;
+  EXPECT_EQ(create_error(c), "created");
+}
+
+TEST(World, GrowingPastTheCoordinateLimitIsRefused) {
+  World w = World::create({.lattice = {.origin = glm::dvec3(0.0), .cell_size = 1e97}}).value();
+  Status s = w.grow_to_include({0, 0, 0}, {1000, 1, 1});
+  ASSERT_FALSE(s.ok());
+  EXPECT_NE(s.message().find("past the limit of 1e+100 m"), std::string::npos) << s.message();
+  EXPECT_EQ(w.chunk_dims(), glm::ivec3(1));  // unchanged
+}
+
 TEST(World, EmptyWorldIsValidAndOutsideEverywhere) {
   World w = World::create({.chunk_dims = {2, 3, 1}}).value();
   EXPECT_TRUE(test::is_valid(w));

@@ -123,8 +123,8 @@ int run_boolean(const BooleanArgs& a, const CommonOptions& common) {
   const bool empty = !w.value().solid_bounds().has_value();
   if (empty) {
     bar.finish();
-    std::fprintf(stderr, "warning: the result is empty: %s; writing a mesh with no triangles to %s\n",
-                 empty_reason(op.value()).c_str(), a.mesh.output.c_str());
+    warn("boolean", "the result is empty: " + empty_reason(op.value()) + "; writing a mesh with no triangles to " +
+                        a.mesh.output);
   }
   nlohmann::json report = {
       {"op", a.op},

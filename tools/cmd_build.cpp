@@ -1,6 +1,7 @@
 // ldc build: mesh, primitive, heightfield or landscape -> .ldc
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -113,6 +114,30 @@ nlohmann::json report_json(const BuildReport& r) {
           {"shell_triangles", r.shell_triangles}};
 }
 
+// What the build read, for the empty-result warning; the mesh's build mode.
+std::string input_name(const BuildArgs& a) {
+  if (!a.input.empty()) return a.input;
+  if (!a.primitive.empty()) return "the " + a.primitive;
+  if (!a.heightfield.empty()) return a.heightfield;
+  return "the landscape";
+}
+
+std::optional<BuildMode> mesh_mode(const BuildArgs& a) {
+  if (a.input.empty()) return std::nullopt;
+  Result<BuildConfig> config = mesh_build_config(a.reading, 1);
+  return config.ok() ? std::optional<BuildMode>(config.value().mode) : std::nullopt;
+}
+
+void print_text(const BuildArgs& a, const BuildReport& report, const nlohmann::json& out) {
+  std::printf("built %s in %.3f s (%zu repaired rays)\n", a.output.c_str(), report.seconds,
+              report.repaired_rays);
+  if (report.surface_components) {
+    std::printf("read %zu components as solids and %zu as shells (%zu triangles)\n",
+                report.solid_components, report.surface_components, report.shell_triangles);
+  }
+  std::printf("%s", world_info_text(out["info"]).c_str());
+}
+
 int run_build(const BuildArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
   ProgressBar bar(!common.quiet);
@@ -120,24 +145,17 @@ int run_build(const BuildArgs& a, const CommonOptions& common) {
   Result<World> w = build_world(a, bar.context(), &report);
   bar.finish();
   if (!w.ok()) return fail("build", w.status());
+  // Validated before the save: an invalid world is never written (exit 2).
+  nlohmann::json info = world_info_json(w.value(), a.validate);
+  if (refuse_invalid_world("build", info, a.output)) return kExitInvalid;
+  const bool empty = warn_if_rasterized_empty("build", w.value(), input_name(a), mesh_mode(a));
   Status s = save_world(w.value(), a.output, {}, bar.context());
   if (!s.ok()) return fail("build", s);
-  nlohmann::json out = {{"output", a.output}, {"build", report_json(report)},
-                        {"info", world_info_json(w.value(), a.validate)}};
+  nlohmann::json out = {{"output", a.output}, {"empty", empty}, {"build", report_json(report)}, {"info", info}};
   out["build"]["stages"] = stage_seconds(*bar.context());
-  if (common.json) {
-    std::printf("%s\n", json_text(out).c_str());
-  } else {
-    std::printf("built %s in %.3f s (%zu repaired rays)\n", a.output.c_str(), report.seconds,
-                report.repaired_rays);
-    if (report.surface_components) {
-      std::printf("read %zu components as solids and %zu as shells (%zu triangles)\n",
-                  report.solid_components, report.surface_components, report.shell_triangles);
-    }
-    std::printf("%s", world_info_text(out["info"]).c_str());
-  }
-  if (a.validate && !out["info"]["validation"]["ok"].get<bool>()) return 2;
-  return 0;
+  if (common.json) std::printf("%s\n", json_text(with_warnings(out)).c_str());
+  else print_text(a, report, out);
+  return kExitSuccess;
 }
 
 }  // namespace
@@ -169,7 +187,7 @@ void add_build_command(CLI::App& app, CommonOptions& common) {
   cmd->add_flag("--terrain", args->terrain, "The procedural landscape (default scene)");
   cmd->add_option("--seed", args->seed, "Landscape seed")->capture_default_str();
   cmd->add_option("--size", args->size, "Landscape size X,Y (m)")->capture_default_str();
-  cmd->add_flag("--validate", args->validate, "Validate the result (exit 2 if invalid)");
+  cmd->add_flag("--validate", args->validate, "Validate the result before writing it (exit 2 and no file if invalid)");
   cmd->callback([args, &common] {
     int code = run_build(*args, common);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -38,7 +38,9 @@ int run_remesh(const ContourArgs& a, const CommonOptions& common) {
   ScopedTimer b(nullptr, "");
   Result<World> w = build_from_mesh(m.value(), a.grid, bar.context());
   if (!w.ok()) return fail("remesh", w.status());
+  bar.finish();
   nlohmann::json report = {{"seconds", {{"load", load}, {"build", b.seconds()}}}};
+  if (warn_if_rasterized_empty("remesh", w.value(), a.input, BuildMode::kSolid)) report["empty"] = true;
   return contour_and_report("remesh", w.value(), a.mesh, bar, std::move(report), common);
 }
 

@@ -134,7 +134,7 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
   if (!s.ok()) return fail("edit", s);
   if (a.validate && !(s = validate_result(live.world(), report)).ok()) {
     fail("edit", s);
-    return 2;  // as `ldc build --validate`
+    return kExitInvalid;  // as `ldc build --validate`
   }
   ScopedTimer save(nullptr, "");
   s = save_world(live.world(), a.output, {}, bar.context());

@@ -25,8 +25,8 @@ int run_info(const InfoArgs& a, const CommonOptions& common) {
   info["file"] = a.input;
   if (common.json) std::printf("%s\n", json_text(info).c_str());
   else std::printf("file        %s\n%s", a.input.c_str(), world_info_text(info).c_str());
-  if (!a.no_validate && !info["validation"]["ok"].get<bool>()) return 2;
-  return 0;
+  if (!a.no_validate && !info["validation"]["ok"].get<bool>()) return kExitInvalid;
+  return kExitSuccess;
 }
 
 }  // namespace

@@ -123,8 +123,10 @@ Result<std::map<uint32_t, size_t>> add_links(NavMesh& nav, const LinksFile& file
     if (nav.link_attached(id.value())) continue;
     for (const auto& [name, end] : {std::pair{"a", link.a}, std::pair{"b", link.b}}) {
       if (probe.nearest_walkable(end, glm::dvec3(link.radius)).ok()) continue;
-      std::fprintf(stderr, "ldc path: warning: %s: end %s (%g, %g, %g) has no walkable floor within %g m; unused\n",
-                   link_context(file, i).c_str(), name, end.x, end.y, end.z, link.radius);
+      char text[160];
+      std::snprintf(text, sizeof(text), ": end %s (%g, %g, %g) has no walkable floor within %g m; unused", name,
+                    end.x, end.y, end.z, link.radius);
+      warn("path", link_context(file, i) + text);
     }
   }
   return index;
@@ -142,10 +144,12 @@ void warn_if_inside_solid(const World& world, const NavConfig& agent, const char
   const bool inside = world.inside(asked) && world.inside(step_up);
   out[std::string(which) + "_inside_solid"] = inside;
   if (!inside || quiet) return;
-  std::fprintf(stderr, "ldc path: warning: the %s (%g, %g, %g) lies inside solid geometry; the path %s at the "
-               "nearest walkable floor, (%g, %g, %g), %.2f m away\n", which, asked.x, asked.y, asked.z,
-               std::string(which) == "start" ? "starts" : "ends", used.x, used.y, used.z,
-               glm::length(used - asked));
+  char text[256];
+  std::snprintf(text, sizeof(text), "the %s (%g, %g, %g) lies inside solid geometry; the path %s at the "
+                "nearest walkable floor, (%g, %g, %g), %.2f m away", which, asked.x, asked.y, asked.z,
+                std::string(which) == "start" ? "starts" : "ends", used.x, used.y, used.z,
+                glm::length(used - asked));
+  warn("path", text);
 }
 
 int run_path(PathArgs a, const CommonOptions& common) {
@@ -211,8 +215,9 @@ int run_path(PathArgs a, const CommonOptions& common) {
     return fail("path", path.status());
   }
   nlohmann::json out = path_json(path.value(), nav.value(), link_index.value(), build_seconds, query_seconds);
-  warn_if_inside_solid(world.value(), a.agent, "start", from, path.value().corners.front(), out, common.quiet);
-  warn_if_inside_solid(world.value(), a.agent, "goal", to, path.value().corners.back(), out, common.quiet);
+  const bool quiet = common.quiet && !common.strict;  // --strict must see the warning it acts on
+  warn_if_inside_solid(world.value(), a.agent, "start", from, path.value().corners.front(), out, quiet);
+  warn_if_inside_solid(world.value(), a.agent, "goal", to, path.value().corners.back(), out, quiet);
   if (a.output.empty()) {
     std::printf("%s\n", json_text(out).c_str());
     if (!common.json) print_summary(stderr, out);

@@ -90,10 +90,6 @@ void print_report(const RenderArgs& a, const Camera& c, const RenderStats& stats
   std::printf("camera %s -> target %s, fov %g  (--camera %.6g,%.6g,%.6g --target %.6g,%.6g,%.6g)\n",
               detail::vec_text(c.position()).c_str(), detail::vec_text(c.target()).c_str(), c.fov(), c.position().x,
               c.position().y, c.position().z, c.target().x, c.target().y, c.target().z);
-  if (stats.started_inside) {
-    std::printf("warning: %zu rays started inside the solid (the camera is inside it; shown purple)\n",
-                stats.started_inside);
-  }
   if (!a.overlay.empty()) {
     std::printf("overlay: %zu path vertices, %zu points; %zu of %zu drawn samples hidden by the solid\n",
                 stats.path_vertices, stats.points, stats.hidden_samples, stats.overlay_samples);
@@ -134,9 +130,13 @@ int run_render(const RenderArgs& a, const CommonOptions& common) {
   seconds["write"] = write.seconds();
   seconds["total"] = total.seconds();
 
+  if (stats.started_inside) {
+    warn("render", std::to_string(stats.started_inside) +
+                       " rays started inside the solid (the camera is inside it; shown purple)");
+  }
   const nlohmann::json report = report_json(a, img.value(), c, stats, seconds);
   if (common.json) {
-    std::printf("%s\n", json_text(report).c_str());
+    std::printf("%s\n", json_text(with_warnings(report)).c_str());
     return 0;
   }
   print_report(a, c, stats, report);

@@ -35,9 +35,10 @@ int run_terrain(TerrainArgs a, const CommonOptions& common) {
   Result<World> w = build_terrain(a.config, a.cell_size, a.chunk, bar.context(), &report);
   bar.finish();
   if (!w.ok()) return fail("terrain", w.status());
+  nlohmann::json info = world_info_json(w.value(), a.validate);
+  if (refuse_invalid_world("terrain", info, a.output)) return kExitInvalid;  // never written
   Status s = save_world(w.value(), a.output);
   if (!s.ok()) return fail("terrain", s);
-  nlohmann::json info = world_info_json(w.value(), a.validate);
   if (common.json) {
     std::printf("%s\n", json_text({{"output", a.output}, {"seconds", report.seconds}, {"info", info}}).c_str());
   } else {
@@ -45,8 +46,7 @@ int run_terrain(TerrainArgs a, const CommonOptions& common) {
                 a.config.size_x, a.config.size_y, a.cell_size, report.seconds, a.output.c_str(),
                 world_info_text(info).c_str());
   }
-  if (a.validate && !info["validation"]["ok"].get<bool>()) return 2;
-  return 0;
+  return kExitSuccess;
 }
 
 }  // namespace
@@ -64,7 +64,7 @@ void add_terrain_command(CLI::App& app, CommonOptions& common) {
   CLI::Option* size_y = cmd->add_option("--size-y", args->config.size_y, "Extent along y (m); use --size X,Y")->group("");
   cmd->add_option("--cell-size", args->cell_size, "Cell size h (m)")->capture_default_str();
   cmd->add_option("--chunk-size,--chunk", args->chunk, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
-  cmd->add_flag("--validate", args->validate, "Validate the result (exit 2 if invalid)");
+  cmd->add_flag("--validate", args->validate, "Validate the result before writing it (exit 2 and no file if invalid)");
   cmd->callback([args, &common, size, size_x, size_y] {
     if (size->count() > 0 && (size_x->count() > 0 || size_y->count() > 0)) {
       throw CLI::RuntimeError(fail("terrain", "give --size X,Y or the deprecated --size-x / --size-y, not both"));

@@ -55,6 +55,44 @@ int fail(const std::string& command, const std::string& message) {
   return 1;
 }
 
+const char* const kExitStatusHelp =
+    "Exit status: 0 success; 1 error (nothing usable written); 2 invalid result (validation found "
+    "errors); 3 a warning under --strict (the output is still written, the warning is on stderr and "
+    "under \"warnings\" in --json).\n";
+
+namespace {
+std::vector<std::string> printed_warnings;  // the tool is one command per process
+}  // namespace
+
+void warn(const std::string& command, const std::string& message) {
+  std::fprintf(stderr, "ldc %s: warning: %s\n", command.c_str(), message.c_str());
+  printed_warnings.push_back(message);
+}
+
+const std::vector<std::string>& warnings() { return printed_warnings; }
+
+nlohmann::json with_warnings(nlohmann::json report) {
+  if (!printed_warnings.empty()) report["warnings"] = printed_warnings;
+  return report;
+}
+
+bool warn_if_rasterized_empty(const std::string& command, const World& world, const std::string& input,
+                              std::optional<BuildMode> mesh_mode) {
+  if (world.solid_bounds()) return false;
+  char cell[32];
+  std::snprintf(cell, sizeof(cell), "%g", world.lattice().cell_size);
+  std::string why = input + " rasterizes to nothing at cell size " + cell + " m: no lattice node lies inside it";
+  if (mesh_mode == BuildMode::kSolid) {
+    why += "; it is thinner than a cell (use a smaller --cell-size or more --cells) or made only of sheets, "
+           "which build mode solid reads as enclosing nothing (build mode auto or surface, ldc build --mode, "
+           "keeps sheets as thin shells)";
+  } else {
+    why += " (use a smaller --cell-size or more --cells)";
+  }
+  warn(command, why + "; the output holds no solid");
+  return true;
+}
+
 bool parse_numbers(const std::string& text, std::vector<double>* out) {
   std::istringstream in(text);
   std::vector<double> v;
@@ -140,6 +178,13 @@ std::string world_info_text(const nlohmann::json& j) {
   for (const auto& [k, v] : j["metadata"].items()) s << "  " << k << ": " << v.get<std::string>() << "\n";
   if (j.contains("validation")) s << validation_text(j["validation"]);
   return s.str();
+}
+
+bool refuse_invalid_world(const std::string& command, const nlohmann::json& info, const std::string& output) {
+  if (!info.contains("validation") || info["validation"]["ok"].get<bool>()) return false;
+  std::fprintf(stderr, "ldc %s: the world is invalid; %s not written\n%s", command.c_str(), output.c_str(),
+               validation_text(info["validation"]).c_str());
+  return true;
 }
 
 void print_seconds(const nlohmann::json& seconds) {

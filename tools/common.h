@@ -1,8 +1,22 @@
-// Shared pieces of the ldc command-line tool: progress bar, errors, JSON output.
+// Shared pieces of the ldc command-line tool: progress bar, errors, warnings,
+// JSON output.
+//
+// Exit status of every command (issue 24; `ldc --help` prints the same):
+//   0  success (warnings, if any, were printed on stderr)
+//   1  error: nothing usable was written (bad arguments, unreadable input,
+//      refused lattice, write failure, out of memory, internal error)
+//   2  invalid result: --validate found errors (build, terrain and edit then
+//      write nothing; info reports a file that is already there)
+//   3  a warning under --strict: the command finished and wrote its output
+//      as it would without --strict, but printed a warning (for example a
+//      non-empty input that rasterizes to nothing, an empty boolean result)
+// An error outranks a warning: a command that warns and then fails exits 1.
 #pragma once
 
 #include <chrono>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
@@ -20,7 +34,15 @@ struct CommonOptions {
   bool json = false;       // machine-readable output on stdout
   bool quiet = false;      // no progress bar
   int threads = 0;         // 0 = all cores
+  bool strict = false;     // a warning exits kExitWarning
 };
+
+inline constexpr int kExitSuccess = 0;
+inline constexpr int kExitError = 1;
+inline constexpr int kExitInvalid = 2;
+inline constexpr int kExitWarning = 3;
+// The exit codes above, for --help.
+extern const char* const kExitStatusHelp;
 
 // A Context whose progress callback draws a bar on stderr once the work has
 // taken more than a second (redrawn in place on a terminal, one line per 10%
@@ -46,6 +68,20 @@ class ProgressBar {
 // Prints "ldc <command>: <message>" on stderr; returns the exit status for it.
 int fail(const std::string& command, const Status& status);
 int fail(const std::string& command, const std::string& message);
+
+// Prints "ldc <command>: warning: <message>" on stderr (after the progress
+// bar's line) and records it: warnings() lists it, with_warnings adds it to
+// --json output, and under --strict main() exits kExitWarning.
+void warn(const std::string& command, const std::string& message);
+const std::vector<std::string>& warnings();
+// `report` with "warnings": [...] added when any were printed.
+nlohmann::json with_warnings(nlohmann::json report);
+
+// Issue 24: a non-empty input whose world holds no solid. Warns, naming the
+// cell size and what would keep it (for a mesh read in `mesh_mode` solid:
+// --mode auto or surface, which keep sheets as shells); returns whether it warned.
+bool warn_if_rasterized_empty(const std::string& command, const World& world, const std::string& input,
+                              std::optional<BuildMode> mesh_mode);
 
 // Reading JSON input files: json_inputs.h.
 
@@ -94,6 +130,11 @@ std::string world_info_text(const nlohmann::json& info);
 // validate() as JSON {"ok", "errors", "nodes_checked", "messages"}, and as text.
 nlohmann::json validation_json(const World& world);
 std::string validation_text(const nlohmann::json& validation);
+
+// --validate before a save: when `info` (world_info_json with validation)
+// says invalid, prints "ldc <command>: the world is invalid; <output> not
+// written" and the validation, and returns true (the caller exits kExitInvalid).
+bool refuse_invalid_world(const std::string& command, const nlohmann::json& info, const std::string& output);
 
 // "  <stage>: <seconds> s", one line per entry of a {"stage": seconds} object.
 void print_seconds(const nlohmann::json& seconds);

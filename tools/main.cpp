@@ -1,5 +1,7 @@
 // The ldc command-line tool: one subcommand per capability. A command-line
 // error exits 1 with its message after "ldc: " (issue 24), as other errors do.
+// Exit codes (0 success, 1 error, 2 invalid result, 3 a warning under
+// --strict): tools/common.h, and the footer of --help.
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -36,6 +38,9 @@ int main(int argc, char** argv) {
   app.add_flag("--json", common.json, "Machine-readable JSON on stdout");
   app.add_flag("-q,--quiet", common.quiet, "No progress bar");
   app.add_option("--threads", common.threads, "Worker threads (0 = all cores)");
+  app.add_flag("--strict", common.strict,
+               "Exit 3 when the command printed a warning (its output is still written)");
+  app.footer(ldc::tool::kExitStatusHelp);
   ldc::tool::add_build_command(app, common);
   ldc::tool::add_info_command(app, common);
   ldc::tool::add_inside_command(app, common);
@@ -48,6 +53,10 @@ int main(int argc, char** argv) {
   ldc::tool::add_gi_command(app, common);
   ldc::tool::add_path_command(app, common);
   ldc::tool::add_voxelize_command(app, common);
+  for (CLI::App* command : app.get_subcommands({})) {  // after a command's own footer, if any
+    const std::string own = command->get_footer();
+    command->footer(own.empty() ? ldc::tool::kExitStatusHelp : own + "\n" + ldc::tool::kExitStatusHelp);
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -59,5 +68,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "ldc: internal error: %s\n", e.what());
     return 1;
   }
-  return 0;
+  // Only a command that succeeded gets here: its warnings decide under --strict.
+  if (common.strict && !ldc::tool::warnings().empty()) return ldc::tool::kExitWarning;
+  return ldc::tool::kExitSuccess;
 }

@@ -35,11 +35,13 @@ ExportOptions export_options(const World& w) {
 }
 
 nlohmann::json quality_json(const MeshQuality& q, const ContourStats& s) {
+  // A mesh with no triangles bounds nothing: neither closed nor watertight (issue 24).
+  const bool empty = q.triangles == 0;
   return {{"triangles", q.triangles},
           {"vertices", q.vertices},
-          {"closed", q.closed()},  // a closed 2-manifold without self-intersections
-          {"watertight", q.watertight()},
-          {"failures", quality_failures(q)},
+          {"closed", !empty && q.closed()},  // a closed 2-manifold without self-intersections
+          {"watertight", !empty && q.watertight()},
+          {"failures", empty ? std::string("empty (no triangles)") : quality_failures(q)},
           {"boundary_edges", q.boundary_edges},
           {"nonmanifold_edges", q.nonmanifold_edges},
           {"nonmanifold_vertices", q.nonmanifold_vertices},
@@ -204,7 +206,7 @@ int write_and_report(const std::string& command, const World& w, const ContourMe
   report["quality"] = quality_json(mesh_quality(mesh, quality_options), stats);
   report["seconds"]["quality"] = q.seconds();  // the report's own cost (self-intersection test included)
   if (common.json) {
-    std::printf("%s\n", json_text(report).c_str());
+    std::printf("%s\n", json_text(with_warnings(std::move(report))).c_str());
     return 0;
   }
   print_report(report);

@@ -37,7 +37,8 @@ struct SnappedMesh {
 
 // Stage 1 of build_from_mesh: vertices to the lattice's fixed point, welded
 // where equal; welded_id maps input vertices to welded ones. Fills
-// `vertices` and `unsnapped` of `out`.
+// `vertices` and `unsnapped` of `out`. Positions no triangle uses are
+// skipped (welded id 0, never read): a stray far vertex is no error.
 Status snap_vertices(const TriangleMesh& mesh, const Lattice& lat, SnappedMesh& out,
                      std::vector<uint32_t>& welded_id);
 
