@@ -17,18 +17,41 @@
  *    *_create / *_load calls and free them with the matching *_destroy
  *    (which accept NULL). The library never keeps a pointer to a caller's
  *    buffer after a call returns.
+ *  - Handles are checked, not trusted. A handle's value is not an address:
+ *    it packs a type tag (a magic number), a slot index and the slot's
+ *    generation into a process-wide table that is never freed, so the
+ *    library never reads freed memory to check one. A destroyed handle
+ *    (destroy twice, use after destroy), a value the library never returned
+ *    and a handle of the other type all give LDC_INVALID_HANDLE. Destroy
+ *    changes the slot's generation, and a slot whose generation would wrap is
+ *    never reused, so an old handle never names a newer object. At most
+ *    2^20 handles of each type (2^14 on 32-bit systems) are live at once
+ *    (LDC_TOO_LARGE beyond).
  *  - Caller-owned buffers: calls that return arrays take a pointer and a
- *    capacity (in elements) and write the needed count. Pass NULL (with
- *    capacity 0) to ask for the count only: the call returns LDC_OK and
- *    writes nothing else. A non-NULL buffer that is too small gives
+ *    capacity (in elements) and write the needed count. Pass NULL with
+ *    capacity 0 to ask for the count only: the call returns LDC_OK and
+ *    writes nothing else. NULL with a non-zero capacity is refused
+ *    (LDC_INVALID_ARGUMENT): it is more likely a failed allocation than a
+ *    size query. A non-NULL buffer that is too small gives
  *    LDC_BUFFER_TOO_SMALL with the needed count written, and nothing else
- *    changes (ldc_world_take_dirty keeps its list).
- *  - Thread safety: calls on one handle must not overlap (a world is not
- *    thread-safe; lock around it if several threads use it). A cascades
- *    handle shares its world's lock: it reads the world and the world's
- *    edits feed it. Other handles may be used concurrently. Heavy calls (building, meshing,
- *    batched ray casts, voxelizing) run in parallel internally (TBB).
- *    ldc_last_error() is per thread.
+ *    changes (ldc_world_take_dirty keeps its list). A capacity (or a ray
+ *    count) whose size in bytes no array can have (over PTRDIFF_MAX) gives
+ *    LDC_TOO_LARGE. The library never writes past the capacity it is given,
+ *    but it cannot tell whether the buffer really is that large: overstating
+ *    a capacity corrupts memory, as it would with memcpy.
+ *  - Thread safety: each world has an atomic in-use count. A world takes any
+ *    number of reading calls at a time (ldc_world_get_info,
+ *    ldc_world_inside, ldc_world_save) or one other call: every other call
+ *    on a world changes it (edits, and ray casts, meshing and path queries,
+ *    which bring the world's caches up to date). A call that would overlap
+ *    another in a conflicting way neither waits nor races: it returns
+ *    LDC_BUSY at once and changes nothing (retry, or lock around the world
+ *    if several threads use it). So does destroying a handle another thread
+ *    is using. A cascades handle takes one call at a time; its calls also
+ *    read its world (an edit of the world meanwhile gets LDC_BUSY), and its
+ *    destroy changes the world. Other handles may be used concurrently.
+ *    Heavy calls (building, meshing, batched ray casts, voxelizing) run in
+ *    parallel internally (TBB). ldc_last_error() is per thread.
  *  - No exceptions or C++ types cross this header; out of memory is
  *    reported as LDC_TOO_LARGE. Enums are 32 bits wide (the *_MAX_ENUM
  *    entries); a value outside an enum's list is refused by name.
@@ -77,6 +100,8 @@ typedef enum ldc_status {
   LDC_INTERNAL = 8,         /* a bug in ldc: please report it with the message */
   LDC_BUFFER_TOO_SMALL = 9, /* a caller buffer is too small: the needed count was written */
   LDC_NOT_FOUND = 10,       /* e.g. no walkable floor near a path's start or goal */
+  LDC_INVALID_HANDLE = 11,  /* a handle destroyed already, or never made by ldc */
+  LDC_BUSY = 12,            /* the handle is in use by an overlapping call on another thread: retry */
   LDC_STATUS_MAX_ENUM = 0x7fffffff /* keeps every enum 32 bits wide (not a status) */
 } ldc_status;
 
@@ -138,8 +163,12 @@ LDC_C_API ldc_status ldc_world_load(const char* path, ldc_world** out);
 /* Writes the world as a .ldc file (zstd level 3). */
 LDC_C_API ldc_status ldc_world_save(const ldc_world* world, const char* path);
 /* Frees the world, its meshes and navigation data. Cascades made from it
- * stay valid handles but refuse updates (destroy them too). NULL is fine. */
-LDC_C_API void ldc_world_destroy(ldc_world* world);
+ * stay valid handles but refuse updates (destroy them too). NULL is fine
+ * (LDC_OK). LDC_INVALID_HANDLE for a world destroyed already; LDC_BUSY,
+ * freeing nothing, while another thread's call uses the world or one of its
+ * cascades. (It returned void before 0.3: callers that ignore the status
+ * still link and run.) */
+LDC_C_API ldc_status ldc_world_destroy(ldc_world* world);
 
 typedef struct ldc_world_info {
   double origin[3];
@@ -155,7 +184,9 @@ typedef struct ldc_world_info {
 } ldc_world_info;
 
 LDC_C_API ldc_status ldc_world_get_info(const ldc_world* world, ldc_world_info* out);
-/* 1 when the point [m] is inside the solid, 0 when not (or on bad input). */
+/* 1 when the point [m] is inside the solid, 0 when not, and 0 when it
+ * cannot answer (a NULL or non-finite point, an invalid or busy handle;
+ * ldc_last_error() then says which). */
 LDC_C_API int ldc_world_inside(const ldc_world* world, const double point[3]);
 
 /* ------------------------------------------------------------------------ */
@@ -266,7 +297,8 @@ typedef struct ldc_ray_hit {
 } ldc_ray_hit;
 
 /* Casts `count` rays (in parallel) into hits[0 .. count). Every ray is
- * checked first: an error names the first bad ray and writes no hit. */
+ * checked first: an error names the first bad ray and writes no hit. A count
+ * no array can hold gives LDC_TOO_LARGE. */
 LDC_C_API ldc_status ldc_world_ray_cast(ldc_world* world, const ldc_ray* rays, size_t count,
                                         ldc_ray_hit* hits);
 
@@ -358,9 +390,9 @@ typedef struct ldc_path_info {
 
 /* A walking path from `from` to `to` [m]. The navigation data is built at
  * the first query and updated from the edits since the last one. Corners go
- * to corners[0 .. 3 * corner_count) as x, y, z; corners may be NULL (the
- * info only). Status LDC_NOT_FOUND when no walkable floor lies near the
- * start or goal. */
+ * to corners[0 .. 3 * corner_count) as x, y, z; corners may be NULL with
+ * corner_capacity 0 (the info only). Status LDC_NOT_FOUND when no walkable
+ * floor lies near the start or goal. */
 LDC_C_API ldc_status ldc_world_find_path(ldc_world* world, const double from[3], const double to[3],
                                          double* corners, size_t corner_capacity, ldc_path_info* info);
 
@@ -380,7 +412,10 @@ LDC_C_API void ldc_cascade_config_default(ldc_cascade_config* config);
  * landscape's table). Nothing is voxelized until an update. */
 LDC_C_API ldc_status ldc_cascades_create(ldc_world* world, const ldc_cascade_config* config,
                                          ldc_cascades** out);
-LDC_C_API void ldc_cascades_destroy(ldc_cascades* cascades);
+/* NULL is fine (LDC_OK). LDC_INVALID_HANDLE for cascades destroyed already;
+ * LDC_BUSY, freeing nothing, while they or their world are in use on
+ * another thread. (It returned void before 0.3.) */
+LDC_C_API ldc_status ldc_cascades_destroy(ldc_cascades* cascades);
 
 typedef struct ldc_cascade_update {
   int32_t level;       /* the level updated */
@@ -400,8 +435,8 @@ LDC_C_API ldc_status ldc_cascades_update_level(ldc_cascades* cascades, int32_t l
 /* One level's six-face G-buffer, camera-centred, in the GPU formats of
  * voxelize.h (PackedGBuffer): per texel of extent (6N, N, N), x fastest,
  * texel (f*N + x, y, z) = face f of voxel lo + (x, y, z). Capacity in texels
- * (6 N^3 needed). Any pointer may be NULL when not wanted; all NULL asks
- * for the count. */
+ * (6 N^3 needed). Any pointer may be NULL when not wanted; all NULL with
+ * texel_capacity 0 asks for the count. */
 typedef struct ldc_gbuffer_buffers {
   uint32_t* albedo;     /* R8G8B8A8_UNORM: rgb albedo, a = surface weight */
   uint32_t* normal;     /* R8G8B8A8_SNORM: xyz normal */
