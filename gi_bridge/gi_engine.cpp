@@ -268,6 +268,103 @@ void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
   }
 }
 
+// Air open to the sky (issue 25; the shaders' sky_open): per level, from
+// the coarsest, a flood through the voxels less than half solid, from the
+// faces of the level's box: all of them on the coarsest level, and on a
+// finer one those whose voxel of the next coarser level is open. Half, so
+// that a wall of one voxel's thickness lying across two voxels still
+// closes the flood, while a tunnel a voxel wide stays open. Solid voxels
+// take the flag of any open air beside them.
+std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vector<uint8_t>* coarser,
+                                 const GiLayout& out) {
+  const int n = out.n;
+  const VoxelBox box = cascades.level_box(l);
+  const auto local = [n](const glm::ivec3& c) { return (size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x); };
+  const auto inside = [n](const glm::ivec3& c) {
+    return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n)));
+  };
+  std::vector<uint8_t> passable(size_t(n) * size_t(n) * size_t(n)), open(passable.size(), 0);
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x)
+        passable[local({x, y, z})] = cascades.occupancy(l, box.lo + glm::ivec3(x, y, z)) < 0.5f;
+  std::vector<glm::ivec3> stack;
+  const VoxelBox up = l + 1 < out.k ? cascades.level_box(l + 1) : VoxelBox{};
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const glm::ivec3 c(x, y, z);
+        const bool face = x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1;
+        if (!face || !passable[local(c)]) continue;
+        bool seed = coarser == nullptr;
+        if (coarser) {
+          const glm::ivec3 parent = ((box.lo + c) >> 1) - up.lo;  // arithmetic shift: floor(g / 2)
+          seed = !inside(parent) || (*coarser)[local(parent)];
+        }
+        if (seed) open[local(c)] = 1, stack.push_back(c);
+      }
+  while (!stack.empty()) {
+    const glm::ivec3 c = stack.back();
+    stack.pop_back();
+    for (int f = 0; f < kFaces; ++f) {
+      glm::ivec3 nb = c;
+      nb[face_axis(f)] += face_positive(f) ? 1 : -1;
+      if (!inside(nb) || !passable[local(nb)] || open[local(nb)]) continue;
+      open[local(nb)] = 1;
+      stack.push_back(nb);
+    }
+  }
+  std::vector<uint8_t> flag = open;  // solid voxels: open where open air touches them
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const glm::ivec3 c(x, y, z);
+        if (passable[local(c)]) continue;
+        for (int f = 0; f < kFaces && !flag[local(c)]; ++f) {
+          glm::ivec3 nb = c;
+          nb[face_axis(f)] += face_positive(f) ? 1 : -1;
+          flag[local(c)] = inside(nb) && open[local(nb)];
+        }
+      }
+  return flag;
+}
+
+// A coarser voxel whose eight children lie in the finer level's box takes
+// their flags (open if any is): the finer flood saw walls the coarse one
+// missed, and without this a coarse voxel of a sealed room, flooded
+// through walls thinner than it, showed the sky in its direct light.
+void restrict_to_finer(const Cascades& cascades, int l, const std::vector<uint8_t>& fine, std::vector<uint8_t>& coarse,
+                       int n) {
+  const glm::ivec3 fine_lo = cascades.level_box(l).lo, coarse_lo = cascades.level_box(l + 1).lo;
+  const auto local = [n](const glm::ivec3& c) { return (size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x); };
+  for (int z = 0; z < n; ++z)
+    for (int y = 0; y < n; ++y)
+      for (int x = 0; x < n; ++x) {
+        const glm::ivec3 child0 = 2 * (coarse_lo + glm::ivec3(x, y, z)) - fine_lo;
+        if (glm::any(glm::lessThan(child0, glm::ivec3(0))) || glm::any(glm::greaterThan(child0, glm::ivec3(n - 2))))
+          continue;
+        uint8_t any_open = 0;
+        for (int k = 0; k < 8; ++k) any_open |= fine[local(child0 + glm::ivec3(k & 1, (k >> 1) & 1, k >> 2))];
+        coarse[local({x, y, z})] = any_open;
+      }
+}
+
+// Writes the flags into vmap's bit 30 (-2 for a voxel with no surface).
+void mark_sky_open(const Cascades& cascades, GiLayout& out) {
+  std::vector<std::vector<uint8_t>> flags(size_t(out.k));
+  for (int l = out.k - 1; l >= 0; --l)
+    flags[size_t(l)] = flood_level(cascades, l, l + 1 < out.k ? &flags[size_t(l) + 1] : nullptr, out);
+  for (int l = 0; l + 1 < out.k; ++l) restrict_to_finer(cascades, l, flags[size_t(l)], flags[size_t(l) + 1], out.n);
+  for (int l = 0; l < out.k; ++l) {
+    const size_t first = out.voxel(l, glm::ivec3(0));
+    for (size_t i = 0; i < flags[size_t(l)].size(); ++i) {
+      if (!flags[size_t(l)][i]) continue;
+      int32_t& v = out.vmap[first + i];
+      v = v < 0 ? -2 : (v | 0x40000000);
+    }
+  }
+}
+
 }  // namespace
 
 Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& lights, const GiConfig& config) {
@@ -291,6 +388,7 @@ Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& light
   out.level_count.assign(size_t(out.k), 0);
   out.level_shadow.assign(size_t(out.k), 0);
   for (int l = 0; l < out.k; ++l) add_level(packed, l, cascades.level_valid(l), out);
+  mark_sky_open(cascades, out);
   fill_params(cascades, lights, config, out);  // after the opacities: injection reads them
   return out;
 }

@@ -68,6 +68,8 @@ cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')
   if [ -x ./build/bench/bench_gi ]; then
     section "Cone-traced GI against a path-traced reference (issue 8)" "CPU engine and path tracer: every core; the Vulkan engine on its device" \
       ./build/bench/bench_gi
+    section "Cone-traced GI in whole images: caves, tunnels, sealed rooms (issue 25)" "CPU engine and path tracer: every core; the Vulkan engine on its device" \
+      ./build/bench/bench_gi 0 256 images docs/images
   else
     echo "(bench_gi not built: needs LDC_WITH_VULKAN and Embree)"
   fi

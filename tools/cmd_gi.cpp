@@ -88,35 +88,14 @@ Result<RadianceImage> reference_image(const World& world, const Camera& cam, con
   if (!mesh.ok()) return mesh.status();
   Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), mats, lights);
   if (!pt.ok()) return pt.status();
-  const size_t n = size_t(cam.width()) * size_t(cam.height());
-  RadianceImage img{cam.width(), cam.height(), std::vector<glm::vec3>(n, glm::vec3(0.0f))};
-  std::vector<glm::vec3>& out = img.pixels;
-  std::vector<glm::dvec3> p;
-  std::vector<glm::vec3> nrm;
-  std::vector<size_t> pix;
-  std::vector<uint16_t> mat;
-  for (int y = 0; y < cam.height(); ++y) {
-    for (int x = 0; x < cam.width(); ++x) {
-      const size_t i = size_t(y) * size_t(cam.width()) + size_t(x);
-      const Ray r = cam.pixel_ray(x, y);
-      const glm::vec3 d = glm::normalize(glm::vec3(r.direction));
-      const PathTracer::Hit h = pt.value()->intersect(r.origin, d);
-      if (!std::isfinite(h.distance)) {
-        out[i] = lights.sky.radiance(d);
-        continue;
-      }
-      p.push_back(r.origin + h.distance * glm::dvec3(d));
-      nrm.push_back(h.normal);
-      pix.push_back(i);
-      mat.push_back(h.material);
-    }
-  }
-  std::vector<glm::vec3> e(p.size());
+  RadianceImage img{cam.width(), cam.height(), std::vector<glm::vec3>(size_t(cam.width()) * size_t(cam.height()))};
+  std::vector<Ray> rays;
+  rays.reserve(img.pixels.size());
+  for (int y = 0; y < cam.height(); ++y)
+    for (int x = 0; x < cam.width(); ++x) rays.push_back(cam.pixel_ray(x, y));
   PathTraceConfig pc;
   pc.samples = samples;
-  if (Status s = pt.value()->irradiance(p, nrm, bounces, e, pc); !s.ok()) return s;
-  for (size_t k = 0; k < pix.size(); ++k)
-    out[pix[k]] = mats[mat[k]].albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + mats[mat[k]].emission;
+  if (Status s = pt.value()->radiance_along(rays, bounces, img.pixels, pc); !s.ok()) return s;
   return img;
 }
 #endif
@@ -148,7 +127,7 @@ void print_report(const GiArgs& a, const GiLights& lights, const GiRun& r, bool 
       j["reference"] = {{"samples", a.samples}};
       j["seconds"]["reference"] = r.reference_seconds;
     }
-    std::printf("%s\n", json_text(j).c_str());
+    std::printf("%s\n", json_text(with_warnings(j)).c_str());
     return;
   }
   std::printf("gi: %s, %d levels of %d^3 voxels of %.3g m, %zu surface voxels; voxelize %.3f s\n", r.device.c_str(),
@@ -228,6 +207,9 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
   if (!w.ok()) return fail("gi", w.status());
   Result<Camera> cam = make_camera(a.camera, up_axis, &w.value());
   if (!cam.ok()) return fail("gi", cam.status());
+  GiLights& scene_lights = lights.value();
+  for (size_t i : remove_buried_lights(w.value(), &scene_lights))
+    warn("gi", "--light " + a.lights[i] + " lies inside the solid and lights nothing (as in the path tracer); left out");
   GiRun run;
   run.up_axis = up_axis;
   run.width = cam.value().width();

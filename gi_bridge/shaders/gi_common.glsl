@@ -12,7 +12,9 @@
 //   voxel v of level l (local coords c):  l * N^3 + (c.z * N + c.y) * N + c.x
 //   occ:    (voxel * 6 + face)            face opacity
 //   alpha:  (voxel * 16 + dir)            premultiplied opacity seen along dir
-//   vmap:   voxel -> surface index or -1
+//   vmap:   voxel -> surface index (bits 0..29) or negative (none), and
+//           whether its air is open to the sky (bit 30; -2 for none + open),
+//           see surface_at and sky_open
 //   attr:   (s * 6 + face) * 3 + {0 albedo rgb+weight, 1 normal xyz, 2 emission}
 //   fsrc:   (s * 6 + face)            light slot the face shows (its own, or
 //                                     the neighbour's it was propagated from), -1 none
@@ -38,6 +40,16 @@ float gi_s0() { return P.fparams.x; }
 float level_size(int l) { return gi_s0() * float(1 << l); }
 
 vec3 voxel_centre(int l, ivec3 c) { return (vec3(IXYZ(P.lo[l]) + c) + vec3(0.5f)) * level_size(l); }
+
+// vmap's two fields (see the layouts above).
+int surface_at(int voxel) {
+  int v = vmap_load(voxel);
+  return v < 0 ? -1 : (v & 0x3FFFFFFF);
+}
+bool sky_open(int voxel) {
+  int v = vmap_load(voxel);
+  return v == -2 || (v >= 0 && (v & 0x40000000) != 0);
+}
 
 int voxel_index(int l, ivec3 c) {
   int n = gi_n();
@@ -125,7 +137,7 @@ void sample_corner(int l, ivec3 c, int dir, float w, vec3 apex, INOUT(ConeSample
   int voxel = voxel_index(l, c);
   bool pre = (gi_flags() & kFlagPrecombined) != 0;
   cs.alpha += w * (pre ? alpha_load(voxel * 16 + dir) : blend_alpha(voxel, d));
-  int s = vmap_load(voxel);
+  int s = surface_at(voxel);
   if (s < 0) return;
   ivec3 seen = ivec3(-1);
   bool ahead = true;
@@ -222,7 +234,8 @@ int march_level(vec3 p, float diam, int l0, OUT(vec3) u) {
 // What one cone gathers: light of the three buffers and of the direct
 // sources, each already multiplied by the transmittance in front of it.
 struct ConeResult {
-  vec3 src;  // sky and injected point lights
+  vec3 src;  // injected point lights
+  float sky;  // transmittance left where the cone escaped the coarsest level (0: it did not)
   vec3 d;
   vec3 b1;
   vec3 b2;
@@ -238,6 +251,7 @@ struct ConeResult {
 ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float t1) {
   ConeResult r;
   r.src = vec3(0.0f);
+  r.sky = 0.0f;
   r.d = vec3(0.0f);
   r.b1 = vec3(0.0f);
   r.b2 = vec3(0.0f);
@@ -257,10 +271,15 @@ ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float 
     }
     float dt = 0.5f * level_size(l);
     // Injected lights in this step, behind the occlusion in front of it.
+    // Read from the level as wide as the cone, not the finer one the
+    // opacity comes from (cone_voxel_width): a light splatted over voxels
+    // narrower than the cone is hit or missed by its axis, not gathered.
     if ((gi_flags() & kFlagLightVolume) != 0) {
       vec3 to = p - lit;
       float g = t * t / max(dot(to, to), t * t);
-      r.src += (T * dt * g) * sample_light_volume(l, u);
+      vec3 ul = vec3(0.0f);
+      int ll = march_level(p, max(2.0f * kTanHalf * t, base), l0, ul);
+      if (ll < gi_k()) r.src += (T * dt * g) * sample_light_volume(ll, ul);
     }
     ConeSample cs = sample_level(l, u, dir, apex);
     float a = min(cs.alpha, 1.0f);
@@ -274,7 +293,7 @@ ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float 
     t += dt;
     if (T < 1e-4f) break;
   }
-  if (escaped) r.src += T * XYZ(P.sky[dir]);
+  if (escaped) r.sky = T;
   r.transmittance = T;
   return r;
 }
@@ -407,9 +426,31 @@ void kernel_cones(int gid) {
   ivec4 sp = surf_pos_load(s);
   ConeResult cr = trace_cone(voxel_centre(sp.w, IXYZ(sp)), dir, sp.w, far_start(sp.w));
   int slot = (s * 16 + dir) * 3;
-  cone_store(slot + 0, vec4(cr.src, 0.0f));
+  cone_store(slot + 0, vec4(cr.src, cr.sky));
   cone_store(slot + 1, vec4(cr.d, 0.0f));
   cone_store(slot + 2, vec4(cr.b1, 0.0f));
+}
+
+// Sky only reaches air open to it. The cones' opacity cannot promise that:
+// a wall thinner than a coarse voxel is half transparent there, so a
+// sealed room with 0.4 m walls got 5% of the sky's light through them
+// (issue 25). So the host floods each level's air from the outside
+// (build_gi_layout: coarsest level from its box's faces, each finer one
+// from the faces of its box where the coarser level is open, through
+// voxels less than half solid) and marks what it reaches (sky_open); a
+// cone's sky counts only from open air. Face f of a surface voxel looks
+// into the air of its neighbour on that side.
+bool face_sky_open(int l, ivec3 c, int f) {
+  ivec3 nb = c;
+  nb[f / 2] += (f % 2 == 0) ? 1 : -1;
+  if (any(lessThan(nb, ivec3(0))) || any(greaterThanEqual(nb, ivec3(gi_n())))) return sky_open(voxel_index(l, c));
+  return sky_open(voxel_index(l, nb));
+}
+// The voxel of level l holding p (outside the level's box: open).
+bool point_sky_open(int l, vec3 p) {
+  vec3 u = vec3(0.0f);
+  if (!level_coords(l, p, u)) return true;
+  return sky_open(voxel_index(l, ivec3(floor(u + vec3(0.5f)))));
 }
 
 // Kernel 3: the second half of a lighting update of surface voxels
@@ -450,15 +491,17 @@ void kernel_update(int gid) {
     vec3 ed = vec3(0.0f);
     vec3 eb = vec3(0.0f);
     vec3 apex_f = apex + (0.5f * vs) * n;
+    float open = face_sky_open(l, IXYZ(sp), f) ? 1.0f : 0.0f;
     for (int i = 0; i < 16; ++i) {
       float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
       if (c <= 0.0f) continue;
-      vec3 src = XYZ(cone_load((s * 16 + i) * 3 + 0));
+      vec4 far_src = cone_load((s * 16 + i) * 3 + 0);
+      vec3 src = XYZ(far_src) + (open * far_src.w) * XYZ(P.sky[i]);
       vec3 gd = XYZ(cone_load((s * 16 + i) * 3 + 1));
       vec3 gb1 = XYZ(cone_load((s * 16 + i) * 3 + 2));
       if (split) {
         ConeResult nr = trace_cone_range(apex_f, i, l, 0.5f * vs, ts - 0.5f * vs * c);
-        es += c * (nr.src + nr.transmittance * src);
+        es += c * (nr.src + (open * nr.sky) * XYZ(P.sky[i]) + nr.transmittance * src);
         ed += c * (nr.d + nr.transmittance * gd);
         eb += c * (nr.b1 + nr.transmittance * gb1);
       } else {
@@ -497,6 +540,7 @@ void kernel_query(int gid) {
   if (l0 == gi_k()) l0 = gi_k() - 1;
   float s = level_size(l0);
   vec3 apex = p + (P.fparams.z * s) * n;
+  float open = point_sky_open(l0, apex) ? 1.0f : 0.0f;
   float wsum = cosine_sum(n);
   vec3 e = vec3(0.0f);
   int bounces = pc.level;
@@ -504,7 +548,7 @@ void kernel_query(int gid) {
     float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
     if (c <= 0.0f) continue;
     ConeResult cr = trace_cone_lit(apex, p, i, l0, 0.5f * s, 1e30f);
-    vec3 l = cr.src + cr.d;
+    vec3 l = cr.src + (open * cr.sky) * XYZ(P.sky[i]) + cr.d;
     if (bounces >= 2) l += cr.b1;
     if (bounces >= 3) l += cr.b2 + third_bounce(cr.b1, cr.b2);
     e += c * l;
