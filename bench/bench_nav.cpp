@@ -7,7 +7,10 @@
 // tests/data/levels (issue 20: one-sided floors, single-quad walls, read with
 // BuildConfig kAuto) and any --level FILE.obj (y up) given.
 //
-//   bench_nav [--quick] [--data DIR] [--level FILE.obj ...]
+//   bench_nav [--quick] [--data DIR] [--level FILE.obj ...] [--scene NAME ...]
+//
+// --scene NAME (repeatable; nav_test, landscape, soup_rooms, ... or a --level
+// file's name) runs only those scenes and skips the analytic terrains.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -285,7 +288,7 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
   mine.scene = scene.name;
   mine.peer = "**ldc** (regions + funnel)";
   mine.build = fmt("%.1f", build_2t) + " (1T " + fmt("%.1f", build_1t) + ")";
-  mine.size = std::to_string(nstats.regions) + " regions";
+  mine.size = std::to_string(nstats.regions) + " regions (" + std::to_string(nstats.chains) + " chains)";
   mine.query_median = fmt("%.2f", percentile(ours.us, 0.5));
   mine.query_p99 = fmt("%.2f", percentile(ours.us, 0.99));
   mine.complete = fmt("%.1f%%", 100.0 * ours.complete / n);
@@ -338,15 +341,17 @@ void run_scene(Scene& scene, bool quick, std::vector<Row>& rows, std::vector<std
 
 int main(int argc, char** argv) {
   // --level FILE.obj (repeatable): that level (y up) as one more soup scene.
-  std::vector<std::string> levels;
+  std::vector<std::string> levels, scenes;
   std::vector<char*> rest{argv[0]};
   for (int i = 1; i < argc; ++i) {
-    if (std::string(argv[i]) == "--level") {
+    const std::string arg = argv[i];
+    if (arg == "--level" || arg == "--scene") {
       if (i + 1 >= argc) {
-        std::fprintf(stderr, "usage: %s [--quick] [--data DIR] [--level FILE.obj ...]\n", argv[0]);
+        std::fprintf(stderr, "usage: %s [--quick] [--data DIR] [--level FILE.obj ...] [--scene NAME ...]\n",
+                     argv[0]);
         return 2;
       }
-      levels.push_back(argv[++i]);
+      (arg == "--level" ? levels : scenes).push_back(argv[++i]);
     } else {
       rest.push_back(argv[i]);
     }
@@ -361,22 +366,32 @@ int main(int argc, char** argv) {
     }
     level_meshes.push_back(std::move(mesh.value()));
   }
+  auto wanted = [&](const std::string& name) {
+    return scenes.empty() || std::find(scenes.begin(), scenes.end(), name) != scenes.end();
+  };
   ldc::bench::print_machine();
   std::vector<Row> rows;
   std::vector<std::string> notes;
-  Scene nav_test = nav_test_scene(args);
-  run_scene(nav_test, args.quick, rows, notes);
-  Scene landscape = landscape_scene();
-  run_scene(landscape, args.quick, rows, notes);
+  if (wanted("nav_test")) {
+    Scene nav_test = nav_test_scene(args);
+    run_scene(nav_test, args.quick, rows, notes);
+  }
+  if (wanted("landscape")) {
+    Scene landscape = landscape_scene();
+    run_scene(landscape, args.quick, rows, notes);
+  }
   // The soup levels of tests/data/levels (tests/levels/make_levels.cpp), then --level files.
   for (const char* level : {"soup_rooms", "soup_storeys", "soup_yard"}) {
+    if (!wanted(level)) continue;
     const std::string file = std::string("levels/") + level + ".obj";
     Scene scene = soup_scene(level, ldc::bench::load(args, file), file);
     run_scene(scene, args.quick, rows, notes);
   }
   for (size_t i = 0; i < levels.size(); ++i) {
     const std::string& path = levels[i];
-    Scene scene = soup_scene(path.substr(path.find_last_of('/') + 1), level_meshes[i], path);
+    const std::string name = path.substr(path.find_last_of('/') + 1);
+    if (!wanted(name)) continue;
+    Scene scene = soup_scene(name, level_meshes[i], path);
     run_scene(scene, args.quick, rows, notes);
   }
   std::printf("\n");
@@ -393,6 +408,7 @@ int main(int argc, char** argv) {
       "Recast build + addTile of the tile holding the dig (tile 32 cells = 9.6 m), from the "
       "re-contoured edited world's triangles near that tile.\n",
       args.quick ? "200" : "1,000");
+  if (!scenes.empty()) return 0;  // a chosen few: no analytic terrains
   // Who is right: both against the exact walkable set of analytic terrains (issue 20 item 5).
   ldc::bench::NavTruthOptions truth;
   truth.pairs = args.quick ? 200 : 1000;

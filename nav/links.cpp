@@ -36,8 +36,8 @@ void attach_one(NavData& data, uint32_t k) {
   auto add_exit = [&](const LinkExit& e) {
     data.link_exits.insert(std::upper_bound(data.link_exits.begin(), data.link_exits.end(), e), e);
   };
-  add_exit({s.region_a, k, false});
-  if (s.link.bidirectional) add_exit({s.region_b, k, true});
+  add_exit({data.node_of(s.region_a), k, false});
+  if (s.link.bidirectional) add_exit({data.node_of(s.region_b), k, true});
   const uint32_t ia = data.island(dense_to_region(data, s.region_a).component);
   const uint32_t ib = data.island(dense_to_region(data, s.region_b).component);
   if (ia == ib) return;

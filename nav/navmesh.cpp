@@ -159,7 +159,11 @@ Result<NavUpdateStats> NavMesh::update(const World& world, std::span<const Dirty
 
 NavStats NavMesh::stats() const {
   NavStats s;
-  s.memory_bytes = sizeof(NavData) + data_->dense_tile.capacity() * sizeof(uint32_t);
+  const NavData& d = *data_;
+  s.memory_bytes = sizeof(NavData) + (d.dense_tile.capacity() + d.node_tile.capacity()) * sizeof(uint32_t) +
+                   d.component_boxes.capacity() * sizeof(detail::RegionBox) +
+                   d.component_runs.capacity() * sizeof(detail::RegionBoxRun) +
+                   d.component_run_first.capacity() * sizeof(uint32_t);
   for (const NavTile& t : data_->tiles) {
     s.memory_bytes += t.memory_bytes();
     s.dropped_floors += t.dropped_floors;
@@ -169,6 +173,7 @@ NavStats NavMesh::stats() const {
     s.walkable += size_t(std::count_if(t.floors.begin(), t.floors.end(),
                                        [](const detail::NavFloor& f) { return f.kept(); }));
     s.regions += t.regions.size();
+    s.chains += t.chains.size();
     s.portals += t.portals.size();
   }
   s.components = data_->component_count;

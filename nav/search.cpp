@@ -28,29 +28,35 @@ std::optional<FloorHit> nearest_floor(const NavData& data, const glm::dvec3& q,
   std::optional<FloorHit> best;
   const glm::ivec2 centre(int(std::lround(q.x)), int(std::lround(q.y)));
   const int rings = int(std::ceil(std::max(reach.x, reach.y))) + 1;
+  auto visit = [&](const glm::ivec2& col) {
+    // The nearest point of the column's square.
+    const glm::dvec2 p(std::clamp(q.x, col.x - 0.5, col.x + 0.5), std::clamp(q.y, col.y - 0.5, col.y + 0.5));
+    if (std::abs(p.x - q.x) > reach.x || std::abs(p.y - q.y) > reach.y) return;
+    int slot = 0;
+    const int index = data.column_in_tile(col, &slot);
+    if (index < 0) return;
+    const NavTile& t = data.tiles[size_t(slot)];
+    for (uint32_t i = t.column_first[size_t(index)]; i < t.column_first[size_t(index) + 1]; ++i) {
+      const NavFloor& f = t.floors[i];
+      if (!f.kept() || (filter && !filter->passes(f.area))) continue;
+      if (std::abs(f.height - q.z) > reach.z) continue;
+      const glm::dvec3 at(p, f.height);
+      const double d = glm::length(at - q);
+      if (!best || d < best->distance) best = FloorHit{slot, i, col, at, d};
+    }
+  };
+  // q lies in its column's square, `off` from its centre (Chebyshev): every
+  // square of ring r is at least r - 0.5 - off away.
+  const double off = std::max(std::abs(q.x - centre.x), std::abs(q.y - centre.y));
   for (int ring = 0; ring <= rings; ++ring) {
-    const double ring_gap = std::max(0.0, ring - 1.0);  // least horizontal distance in this ring
+    const double ring_gap = std::max(0.0, ring - 0.5 - off);  // least horizontal distance in this ring
     if (best && ring_gap > best->distance) break;
+    // The ring's columns in rows (dy), each row's in dx order: full rows at
+    // the top and bottom, the two ends between (the order the square scan had).
     for (int dy = -ring; dy <= ring; ++dy) {
-      for (int dx = -ring; dx <= ring; ++dx) {
-        if (std::max(std::abs(dx), std::abs(dy)) != ring) continue;
-        const glm::ivec2 col = centre + glm::ivec2(dx, dy);
-        // The nearest point of the column's square.
-        const glm::dvec2 p(std::clamp(q.x, col.x - 0.5, col.x + 0.5),
-                           std::clamp(q.y, col.y - 0.5, col.y + 0.5));
-        if (std::abs(p.x - q.x) > reach.x || std::abs(p.y - q.y) > reach.y) continue;
-        int slot = 0;
-        const int index = data.column_in_tile(col, &slot);
-        if (index < 0) continue;
-        const NavTile& t = data.tiles[size_t(slot)];
-        for (uint32_t i = t.column_first[size_t(index)]; i < t.column_first[size_t(index) + 1]; ++i) {
-          const NavFloor& f = t.floors[i];
-          if (!f.kept() || (filter && !filter->passes(f.area))) continue;
-          if (std::abs(f.height - q.z) > reach.z) continue;
-          const glm::dvec3 at(p, f.height);
-          const double d = glm::length(at - q);
-          if (!best || d < best->distance) best = FloorHit{slot, i, col, at, d};
-        }
+      const bool full_row = dy == -ring || dy == ring;
+      for (int dx = -ring; dx <= ring; dx += full_row || ring == 0 ? 1 : 2 * ring) {
+        visit(centre + glm::ivec2(dx, dy));
       }
     }
   }
@@ -93,6 +99,58 @@ float heuristic_scale(const NavFilter& filter) {
   double cheapest = 1.0;  // areas the filter does not list cost 1
   for (double c : filter.area_cost) cheapest = std::min(cheapest, c);
   return float(0.999 * cheapest);
+}
+
+// Distance from q to a region box (its rectangle and height range).
+double box_distance(const detail::RegionBox& b, const glm::dvec3& q) {
+  const glm::dvec3 near(std::clamp(q.x, double(b.lo.x), double(b.hi.x)),
+                        std::clamp(q.y, double(b.lo.y), double(b.hi.y)),
+                        std::clamp(q.z, double(b.height_min), double(b.height_max)));
+  return glm::length(near - q);
+}
+
+// The filter-passing region of `island` nearest `aim` by box distance (no
+// floor lookups), the lowest dense index on ties; `fallback` when none.
+// Runs of boxes (a component's regions in one tile) whose bounds are farther
+// than the best so far are skipped; the nearest run is scanned first so the
+// best is good early.
+uint32_t nearest_island_region(const NavData& data, uint32_t island, const glm::dvec3& aim,
+                               const NavFilter& filter, uint32_t fallback) {
+  double best = std::numeric_limits<double>::infinity();
+  uint32_t best_region = fallback;
+  auto scan = [&](const detail::RegionBoxRun& run) {
+    for (uint32_t i = run.first; i < run.first + run.count; ++i) {
+      const detail::RegionBox& b = data.component_boxes[i];
+      if (!filter.passes(b.area)) continue;
+      const double d = box_distance(b, aim);
+      if (d < best || (d == best && b.dense < best_region)) {
+        best = d;
+        best_region = b.dense;
+      }
+    }
+  };
+  auto for_island_runs = [&](auto fn) {
+    for (uint32_t c = 0; c < data.component_count; ++c) {
+      if (data.island(c) != island) continue;
+      for (uint32_t k = data.component_run_first[c]; k < data.component_run_first[c + 1]; ++k) {
+        fn(k, box_distance(data.component_runs[k].bounds, aim));
+      }
+    }
+  };
+  uint32_t nearest_run = UINT32_MAX;
+  double nearest_run_distance = std::numeric_limits<double>::infinity();
+  for_island_runs([&](uint32_t k, double d) {
+    if (d < nearest_run_distance) {
+      nearest_run_distance = d;
+      nearest_run = k;
+    }
+  });
+  if (nearest_run == UINT32_MAX) return fallback;
+  scan(data.component_runs[nearest_run]);
+  for_island_runs([&](uint32_t k, double d) {
+    if (k != nearest_run && d <= best) scan(data.component_runs[k]);
+  });
+  return best_region;
 }
 
 uint32_t dense_region(const NavData& data, const detail::FloorHit& hit) {
@@ -163,7 +221,7 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
     return no_floor(mesh_, "no walkable floor within " + detail::vec_text(options.search_half_extents) +
                                " m of the path start " + detail::vec_text(from));
   }
-  s.reset(data.dense_count);
+  s.reset(data.node_count);
   s.filter = options.filter;
   s.heuristic_scale = heuristic_scale(options.filter);
   // Areas missing from area_flags have flags 1: a filter that passes flag 1
@@ -179,27 +237,15 @@ Status NavQuery::begin_path(const glm::dvec3& from, const glm::dvec3& to,
     s.target_region = dense_region(data, *goal);
     s.goal_reachable = true;
   } else {
-    // Unreachable: aim at the start island's point nearest the goal. Regions
-    // are ranked by the distance to their rectangle and height range (no
-    // floor lookups); the floor is looked up for the nearest only.
+    // Unreachable: aim at the start island's point nearest the goal.
     const glm::dvec3 aim = goal ? goal->point : goal_nav;
-    double best = std::numeric_limits<double>::infinity();
-    for (uint32_t r = 0; r < data.dense_count; ++r) {
-      const NavRegion& reg = detail::dense_to_region(data, r);
-      if (data.island(reg.component) != island || !options.filter.passes(reg.area)) continue;
-      const glm::dvec3 near(std::clamp(aim.x, reg.lo.x - 0.5, reg.hi.x + 0.5),
-                            std::clamp(aim.y, reg.lo.y - 0.5, reg.hi.y + 0.5),
-                            std::clamp(aim.z, double(reg.height_min), double(reg.height_max)));
-      const double d = glm::length(near - aim);
-      if (d < best) {
-        best = d;
-        s.target_region = r;
-      }
-    }
+    s.target_region = nearest_island_region(data, island, aim, options.filter, s.start_region);
     s.target = detail::nearest_point_of_region(data, s.target_region, aim);
     s.goal_reachable = false;
   }
-  s.push_start(s.start_region, s.start, glm::length(s.target - s.start));
+  s.start_node = data.node_of(s.start_region);
+  s.target_node = data.node_of(s.target_region);
+  s.push_start(s.start_node, s.start, glm::length(s.target - s.start));
   s.active = true;
   return {};
 }

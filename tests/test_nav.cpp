@@ -343,6 +343,49 @@ TEST(Nav, TwoLevelsWithABridge) {
   EXPECT_GE(nav.stats().components, 2u);
 }
 
+// A floor with a diagonal staircase edge (x + y <= 13 in 1 m steps): the
+// rectangles along the edge are strips, chained into far fewer search nodes,
+// and a path along the edge is still the straight line, both ways (of two
+// entries into a chain the search keeps the one on the better way on, not
+// the cheaper to reach).
+TEST(Nav, StaircaseEdgeStripsAreChainedAndPathsStayStraight) {
+  std::vector<Box> boxes;
+  for (int k = 0; k <= 10; ++k) boxes.push_back({{0.05, 0.05, 0.25}, {1.05 + k, 12.05 - k, 1.0}});
+  const NavMesh nav = nav_of(boxes_world(boxes));
+  const NavStats stats = nav.stats();
+  EXPECT_GE(stats.regions, 10u);
+  EXPECT_LT(stats.chains * 2, stats.regions);
+  // Along x + y = 9, 2 m inside the edge: in sight of each other.
+  for (const auto& [from, to] : {std::pair{glm::dvec3(1, 8, 1), glm::dvec3(8, 1, 1)},
+                                 std::pair{glm::dvec3(8, 1, 1), glm::dvec3(1, 8, 1)}}) {
+    const NavPath path = path_of(nav, from, to);
+    ASSERT_EQ(path.status, PathStatus::kComplete);
+    EXPECT_NEAR(path.length, 7.0 * std::sqrt(2.0), 1e-6) << "the straight line";
+    EXPECT_GT(path.regions, path.nodes_searched / 4) << "the corridor counts rectangles, the search chains";
+    expect_on_walkable_ground(nav, path);
+  }
+}
+
+// A wall across the floor whose end is reached through chained strips (a
+// diagonal edge beside it): the path bends round the wall's end, on the
+// ground, no longer than the grid baseline.
+TEST(Nav, ChainedStripsDoNotLetThePathCutThroughAWall) {
+  std::vector<Box> boxes;
+  for (int k = 0; k <= 10; ++k) boxes.push_back({{0.05, 0.05, 0.25}, {1.05 + k, 12.05 - k, 1.0}});
+  boxes.push_back({{4.9, 0.0, 0.5}, {5.1, 4.0, 3.0}});  // wall from the south edge up to y = 4
+  const NavMesh nav = nav_of(boxes_world(boxes));
+  const glm::dvec3 a(2, 2, 1), b(8, 2, 1);
+  const NavPath path = path_of(nav, a, b);
+  ASSERT_EQ(path.status, PathStatus::kComplete);
+  EXPECT_GE(path.corners.size(), 3u);
+  expect_on_walkable_ground(nav, path);
+  NavQuery grid(nav, 1 << 20);
+  Result<NavPath> baseline = grid.find_grid_path(a, b);
+  ASSERT_TRUE(baseline.ok());
+  ASSERT_EQ(baseline->status, PathStatus::kComplete);
+  EXPECT_LE(path.length, baseline->length + 1e-6);
+}
+
 TEST(Nav, UnreachableGoalGivesThePartialPathToTheNearestPoint) {
   const World world = boxes_world({floor_slab(0, 0, 8, 4), floor_slab(10, 0, 18, 4)});
   const NavMesh nav = nav_of(world);
@@ -452,6 +495,7 @@ TEST(Nav, UpdateEqualsRebuildAfterRandomEdits) {
     EXPECT_EQ(a.floors, b.floors) << "edit " << i;
     EXPECT_EQ(a.walkable, b.walkable) << "edit " << i;
     EXPECT_EQ(a.regions, b.regions) << "edit " << i;
+    EXPECT_EQ(a.chains, b.chains) << "edit " << i;
     EXPECT_EQ(a.portals, b.portals) << "edit " << i;
     EXPECT_EQ(a.components, b.components) << "edit " << i;
     NavQuery qa(nav), qb(fresh);

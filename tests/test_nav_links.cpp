@@ -159,6 +159,27 @@ TEST(NavLinks, ALinkJoinsTwoIslandsAndRemovingItSplitsThem) {
   EXPECT_FALSE(nav.remove_link(id).ok()) << "already gone";
 }
 
+// An unreachable goal: the partial path ends at the point nearest the goal
+// of the start's island, which a link makes two components: the far one's.
+TEST(NavLinks, UnreachableGoalAimsAtTheNearestPointOfTheWholeLinkedIsland) {
+  NavMesh nav = NavMesh::build(world_of({{{0.05, 0.05, 0.25}, {7.95, 7.95, 1.0}},
+                                         {{11.05, 0.05, 0.25}, {18.95, 7.95, 1.0}},
+                                         {{30.05, 0.05, 0.25}, {37.95, 7.95, 1.0}}}),
+                               {})
+                    .value();
+  const glm::dvec3 a(2, 4, 1), goal(34, 4, 1);
+  EXPECT_NEAR(path(nav, a, goal).corners.back().x, 7.3, 1e-6) << "no link: the start platform's east edge";
+  NavLink jump;
+  jump.a = {7.0, 4.0, 1.0};
+  jump.b = {12.0, 4.0, 1.0};
+  ASSERT_TRUE(nav.add_link(jump).ok());
+  const NavPath p = path(nav, a, goal);
+  EXPECT_EQ(p.status, PathStatus::kUnreachable);
+  ASSERT_EQ(p.links.size(), 1u);
+  EXPECT_NEAR(p.corners.back().x, 18.3, 1e-6) << "the middle platform's east edge, eroded 0.6 m";
+  EXPECT_NEAR(p.corners.back().y, 4.0, 1e-6);
+}
+
 TEST(NavLinks, OneWayLinkIsTakenOnlyForwards) {
   NavMesh nav = NavMesh::build(two_platforms(), {}).value();
   NavLink drop;

@@ -255,7 +255,7 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
                 "Keep floors beside drops deeper than --max-climb (Recast's ledge filter)");
   cmd->add_flag("!--no-filter-low-height", args->agent.filter_low_height_spans,
                 "Keep floors with less than --agent-height above them (Recast's low-height filter)");
-  cmd->add_option("--max-nodes", args->max_nodes, "A* node budget in regions, clamped to 16 .. 1048576 (default: NavQuery's, as in nav/nav.h)")
+  cmd->add_option("--max-nodes", args->max_nodes, "A* node budget in chains of rectangles (nav/nav.h), clamped to 16 .. 1048576 (default: NavQuery's, as in nav/nav.h)")
       ->capture_default_str();
   cmd->add_option("--filter", args->filter_file, "Query filter (JSON): per-material costs and exclusions (below)");
   cmd->add_option("--links", args->links_file, "Off-mesh links (JSON): jumps, ladders, teleporters (below)");

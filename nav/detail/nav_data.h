@@ -19,6 +19,7 @@ inline constexpr uint8_t kNoLink = 0xFF;
 inline constexpr float kRiserNormalUp = 0.17364818f;  // sin(10 degrees)
 inline constexpr uint16_t kNoRegion = 0xFFFF;       // not walkable, or eroded away
 inline constexpr uint16_t kUnassigned = 0xFFFE;     // kept by erosion, not yet in a rectangle
+inline constexpr uint8_t kNoPortal = 0xFF;
 inline constexpr int kMaxLevels = 254;  // floors per column kept (link indices are bytes)
 // Floors per tile kept (16-bit offsets and region ids): 63 floors in every
 // column of a 32 x 32 tile, 15 at C = 64. Floors beyond it are dropped and
@@ -57,14 +58,33 @@ struct NavRegion {
   uint32_t portal_count = 0;
   uint32_t component = 0;     // connected island id (valid after relabelling)
   uint8_t area = 0;           // every floor of a rectangle has the same
+  uint16_t chain = 0;         // the tile's chain holding it (the A* node)
+  // The portals to the next and the previous rectangle of the chain (offsets
+  // from first_portal; kNoPortal at the chain's ends).
+  uint8_t to_next = kNoPortal;
+  uint8_t to_previous = kNoPortal;
+};
+
+// A chain: rectangles of one tile and area, each the next one's neighbour
+// across its +u side (or each across its +v side), numbered consecutively
+// in that order: regions [first, first + count). The A* runs over chains
+// (the landscape's 1,646 rectangles, mostly one-cell strips along diagonal
+// edges, make 616 chains) and the funnel over the rectangles of the chains
+// it chose, entry to exit, so paths stay exact. Chains stay inside a tile,
+// so an update re-chains only the tiles it re-covers.
+struct NavChain {
+  uint16_t first = 0;
+  uint16_t count = 0;
+  bool holds(uint16_t region) const { return uint16_t(region - first) < count; }
 };
 
 // A directed portal from a region to a neighbouring one: the shared side's
 // segment from a to b (2D lattice coordinates), heights at both ends.
 struct NavPortal {
   uint32_t to_tile = 0;
-  uint32_t to_dense = 0;  // the target's dense index (set by relabel)
+  uint32_t to_node = 0;  // the target's search node: its chain's dense index (set by relabel)
   uint16_t to_region = 0;
+  uint16_t from_region = 0;  // the source region (in this tile)
   uint8_t dir = 0;  // side of the source region it lies on
   glm::vec2 a{0.0f};
   glm::vec2 b{0.0f};
@@ -72,13 +92,34 @@ struct NavPortal {
   float height_b = 0.0f;
 };
 
+// A region's ground-plane squares and height range, for finding the region
+// of an island nearest a point without touching the tiles.
+struct RegionBox {
+  glm::vec2 lo{0.0f};  // corners of its columns' squares (columns -/+ half a cell)
+  glm::vec2 hi{0.0f};
+  float height_min = 0.0f;
+  float height_max = 0.0f;
+  uint32_t dense = 0;
+  uint8_t area = 0;
+};
+
+// The boxes of one component in one tile (a run of NavData::component_boxes)
+// and the box bounding them all: a scan skips the run when that is too far.
+struct RegionBoxRun {
+  RegionBox bounds;
+  uint32_t first = 0;
+  uint32_t count = 0;
+};
+
 struct NavTile {
   glm::ivec2 coord{0};                 // chunk coordinates on (u, v)
   std::vector<uint16_t> column_first;  // C*C + 1 offsets into floors; empty when no floors
   std::vector<NavFloor> floors;
-  std::vector<NavRegion> regions;
+  std::vector<NavRegion> regions;      // grouped by chain, in chain order
+  std::vector<NavChain> chains;
   std::vector<NavPortal> portals;      // grouped by region
-  uint32_t dense_first = 0;            // first dense region index (for searches)
+  uint32_t dense_first = 0;            // first dense region index
+  uint32_t node_first = 0;             // first search node (dense chain index)
   uint32_t dense_floor_first = 0;      // first dense floor index (for grid searches)
   uint32_t dropped_floors = 0;         // floors beyond kMaxTileFloors, left out
 
@@ -95,12 +136,15 @@ struct NavLinkSlot {
   glm::dvec3 a{0.0}, b{0.0};
 };
 
-// A way out of a region by a link: its slot, and whether it runs b -> a.
+// A way out of a search node (a chain) by a link: its slot, and whether it runs b -> a.
 struct LinkExit {
-  uint32_t region = 0;
+  uint32_t node = 0;
   uint32_t slot = 0;
   bool reversed = false;
-  bool operator<(const LinkExit& o) const { return region < o.region; }
+  bool operator<(const LinkExit& o) const { return node < o.node; }
+  // The regions (dense) it takes off from and lands in.
+  uint32_t take_off(const NavLinkSlot& l) const { return reversed ? l.region_b : l.region_a; }
+  uint32_t landing(const NavLinkSlot& l) const { return reversed ? l.region_a : l.region_b; }
 };
 
 struct NavData {
@@ -122,8 +166,15 @@ struct NavData {
   std::vector<NavTile> tiles;          // tile_dims.x * tile_dims.y, x fastest
   std::vector<uint32_t> dense_tile;    // dense region index -> tile slot
   uint32_t dense_count = 0;
+  std::vector<uint32_t> node_tile;     // search node (dense chain index) -> tile slot
+  uint32_t node_count = 0;
   uint32_t dense_floor_count = 0;
   uint32_t component_count = 0;
+  // Region boxes grouped by component (then by tile, in dense order), in runs
+  // per tile; component c's runs are [component_run_first[c], [c + 1]).
+  std::vector<RegionBox> component_boxes;
+  std::vector<RegionBoxRun> component_runs;
+  std::vector<uint32_t> component_run_first;
   // Off-mesh links, the exits they give each region (sorted by region), and
   // per component the island it joins through links (the island check).
   std::vector<NavLinkSlot> links;
@@ -150,6 +201,12 @@ struct NavData {
   // The column's index in its tile (its vertical ray), and the tile slot;
   // -1 when outside the mesh or in a floorless tile.
   int column_in_tile(const glm::ivec2& column, int* tile_slot_out) const;
+
+  // The search node (chain) of a dense region.
+  uint32_t node_of(uint32_t dense_region) const {
+    const NavTile& t = tiles[dense_tile[dense_region]];
+    return t.node_first + t.regions[dense_region - t.dense_first].chain;
+  }
 
   // Lattice (u, v, up) of a world position, and back.
   glm::dvec3 to_nav(const glm::dvec3& world) const;

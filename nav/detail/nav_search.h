@@ -34,8 +34,9 @@ glm::dvec3 nearest_point_of_region(const NavData& data, uint32_t dense, const gl
 struct SearchNodes {
   std::vector<uint32_t> stamp;
   std::vector<float> cost;           // g
+  std::vector<float> estimate;       // f = g + h, as pushed
   std::vector<uint32_t> parent;      // node index, or UINT32_MAX
-  std::vector<uint32_t> via;         // region search: portal index in the parent's tile, or kViaLink | link exit
+  std::vector<uint32_t> via;         // chain search: portal index in the parent's tile, or kViaLink | link exit
   std::vector<glm::vec3> position;   // where the node is entered
   std::vector<uint8_t> closed;
   std::vector<std::pair<float, uint32_t>> heap;  // (f, node), min-heap by f
@@ -59,6 +60,12 @@ NavPath grid_search(const NavData& data, const FloorHit& start, const FloorHit& 
 
 inline constexpr uint32_t kViaLink = 0x80000000u;
 
+// A portal's ends as seen walking through it (for string pulling).
+struct FunnelPortal {
+  glm::dvec3 left{0.0};
+  glm::dvec3 right{0.0};
+};
+
 struct NavSearch {
   SearchNodes nodes;
   NavFilter filter;
@@ -71,28 +78,33 @@ struct NavSearch {
   bool out_of_nodes = false;
   bool goal_reachable = false;
   glm::dvec3 start{0.0}, target{0.0};
-  uint32_t start_region = 0, target_region = 0;
+  uint32_t start_region = 0, target_region = 0;  // dense regions
+  uint32_t start_node = 0, target_node = 0;      // their chains: the search's nodes
   uint32_t best = 0;  // explored node nearest the target
   double best_distance = 0.0;
 
-  void reset(uint32_t region_count);
-  void push_start(uint32_t region, const glm::dvec3& at, double to_target);
+  void reset(uint32_t node_count);
+  void push_start(uint32_t node, const glm::dvec3& at, double to_target);
+  // Scratch for expand_one: per rectangle of the chain expanded, where it is
+  // entered and the cost there.
+  std::vector<glm::vec3> chain_at;
+  std::vector<float> chain_cost;
+  uint16_t entry_region(const NavData& data, uint32_t n) const;
+  void walk_chain(const NavData& data, uint32_t n, float own_cost);
   // Expands the cheapest open node; false when the search is over.
   bool expand_one(const NavData& data, int max_nodes);
   // Offers node m, entered at `at` from n with cost g so far.
   void relax(const NavData& data, uint32_t n, uint32_t m, const glm::vec3& at, float g, uint32_t via,
              int max_nodes);
   // The corridor to the target (or the best node) pulled taut; lengths in cells.
-  NavPath make_path(const NavData& data) const;
+  NavPath make_path(const NavData& data);
+  std::vector<uint32_t> corridor;  // scratch for make_path
+  std::vector<FunnelPortal> funnel;
 };
 
-// String pulling through a corridor's portals: corners[0] = start, last =
-// end; `left`/`right` are the portal ends as seen walking through them.
-struct FunnelPortal {
-  glm::dvec3 left{0.0};
-  glm::dvec3 right{0.0};
-};
-std::vector<glm::dvec3> pull_string(const glm::dvec3& start, const glm::dvec3& end,
-                                    const std::vector<FunnelPortal>& portals);
+// String pulling (the funnel algorithm) over portals whose first and last
+// are the start and the end (as {p, p}): appends the corners after the start
+// to `out`, whose last is the start.
+void pull_string_onto(const std::vector<FunnelPortal>& portals, std::vector<glm::dvec3>& out);
 
 }  // namespace ldc::detail
