@@ -12,6 +12,7 @@
 #include "common.h"
 #include "contour/contour.h"
 #include "gi_bridge/gi.h"
+#include "json_inputs.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
 #include "render/render.h"
@@ -146,6 +147,13 @@ void print_report(const GiArgs& a, const GiLights& lights, const GiRun& r, bool 
 // Checks what needs no world, so that it fails before the world loads.
 Status check_args(const GiArgs& a) {
   if (Status s = check_camera_args(a.camera); !s.ok()) return s;
+  // Refused, not replaced: -1 used to mean the default voxel size, and a
+  // NaN exposure wrote a black image (issue 24, finding 11).
+  if (!(a.voxel_size == 0.0 || (a.voxel_size > 0.0 && std::isfinite(a.voxel_size))))
+    return Status(ErrorCode::kInvalidArgument,
+                  "--voxel-size " + number_text(a.voxel_size) + ": must be a finite length > 0 (m; default 2 h)");
+  if (!(a.exposure > 0.0f && std::isfinite(a.exposure)))
+    return Status(ErrorCode::kInvalidArgument, "--exposure " + number_text(a.exposure) + ": must be finite and > 0");
   if (a.passes < 1 || a.passes > 16)
     return Status(ErrorCode::kInvalidArgument, "--passes " + std::to_string(a.passes) + ": must be 1 .. 16");
   if (a.bounces < 1 || a.bounces > 3)

@@ -155,6 +155,9 @@ void warn_if_inside_solid(const World& world, const NavConfig& agent, const char
 int run_path(PathArgs a, const CommonOptions& common) {
   set_thread_count(common.threads);
   glm::dvec3 from, to;
+  if (a.max_nodes < 16 || a.max_nodes > (1 << 20))
+    return fail("path", Status(ErrorCode::kInvalidArgument,
+                               "--max-nodes " + std::to_string(a.max_nodes) + ": must be 16 .. 1048576"));
   if (!parse_vec3(a.from, &from)) return fail("path", "--from " + a.from + ": expected x,y,z");
   if (!parse_vec3(a.to, &to)) return fail("path", "--to " + a.to + ": expected x,y,z");
   // A mesh level follows the Recast convention (y up); an .ldc world records none (z).
@@ -255,7 +258,7 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
                 "Keep floors beside drops deeper than --max-climb (Recast's ledge filter)");
   cmd->add_flag("!--no-filter-low-height", args->agent.filter_low_height_spans,
                 "Keep floors with less than --agent-height above them (Recast's low-height filter)");
-  cmd->add_option("--max-nodes", args->max_nodes, "A* node budget in chains of rectangles (nav/nav.h), clamped to 16 .. 1048576 (default: NavQuery's, as in nav/nav.h)")
+  cmd->add_option("--max-nodes", args->max_nodes, "A* node budget in chains of rectangles (nav/nav.h), 16 .. 1048576 (default: NavQuery's, as in nav/nav.h)")
       ->capture_default_str();
   cmd->add_option("--filter", args->filter_file, "Query filter (JSON): per-material costs and exclusions (below)");
   cmd->add_option("--links", args->links_file, "Off-mesh links (JSON): jumps, ladders, teleporters (below)");
