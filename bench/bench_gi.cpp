@@ -24,6 +24,7 @@
 
 #include "contour/contour.h"
 #include "gi_images.h"
+#include "scene_builders.h"
 #include "csg/csg.h"
 #include "gi_bridge/gi.h"
 #include "gi_bridge/path_trace.h"
@@ -46,16 +47,7 @@ struct Scene {
   MaterialTable materials;
 };
 
-void add_box(TriangleMesh& m, glm::dvec3 lo, glm::dvec3 hi, uint16_t mat) {
-  const uint32_t b = uint32_t(m.positions.size());
-  for (int i = 0; i < 8; ++i) m.positions.emplace_back(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
-  const uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& f : q) {
-    m.triangles.emplace_back(b + f[0], b + f[1], b + f[2]);
-    m.triangles.emplace_back(b + f[0], b + f[2], b + f[3]);
-    m.triangle_material.insert(m.triangle_material.end(), {mat, mat});
-  }
-}
+using bench::add_box;
 
 World build(const TriangleMesh& m, double h) {
   GridConfig g;

@@ -13,6 +13,7 @@
 // DIR/gi_<view>.png: the cone tracer (CPU engine) on the left, the
 // reference on the right.
 #include "gi_images.h"
+#include "scene_builders.h"
 
 #include <algorithm>
 #include <cmath>
@@ -43,42 +44,6 @@ struct View {
   GiLights lights;
   MaterialTable materials;
 };
-
-// The main job's world: the default landscape with scripts/default-tunnel.json's
-// edits (a tunnel through it with a chamber, a pillar and a sand floor).
-World main_job_tunnel() {
-  Result<World> w = build_terrain(TerrainConfig{}, 0.2);
-  if (!w.ok()) std::exit(1);
-  WorldEditor ed(std::move(w).value());
-  NoiseSphere chamber;
-  chamber.radius = 2.8;
-  chamber.amplitude = 0.35;
-  chamber.frequency = 1.5;
-  chamber.seed = 3;
-  const std::pair<Brush, EditOp> edits[] = {
-      {Brush::capsule({-1, 9, 3.2}, {12, 10, 3.6}, 1.5), EditOp::kSubtract},
-      {Brush::capsule({12, 10, 3.6}, {24, 9, 3.8}, 1.5), EditOp::kSubtract},
-      {Brush::noisy_sphere({24, 9, 4.2}, chamber), EditOp::kSubtract},
-      {Brush::capsule({24, 9, 3.8}, {36, 11, 3.6}, 1.5), EditOp::kSubtract},
-      {Brush::capsule({36, 11, 3.6}, {49, 10, 3.0}, 1.5), EditOp::kSubtract},
-      {Brush::cylinder({24, 9, 1}, {24, 9, 7.5}, 0.45, 2), EditOp::kUnion},
-      {Brush::capsule({-1, 9.5, 2.0}, {49, 10, 2.0}, 1.4, 3), EditOp::kPaint}};
-  for (const auto& [brush, op] : edits) {
-    if (!ed.apply(brush, op).ok()) std::exit(1);
-  }
-  return ed.world();
-}
-
-void add_box(TriangleMesh& m, glm::dvec3 lo, glm::dvec3 hi, uint16_t mat) {
-  const uint32_t b = uint32_t(m.positions.size());
-  for (int i = 0; i < 8; ++i) m.positions.emplace_back(i & 1 ? hi.x : lo.x, i & 2 ? hi.y : lo.y, i & 4 ? hi.z : lo.z);
-  const uint32_t q[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& f : q) {
-    m.triangles.emplace_back(b + f[0], b + f[1], b + f[2]);
-    m.triangles.emplace_back(b + f[0], b + f[2], b + f[3]);
-    m.triangle_material.insert(m.triangle_material.end(), {mat, mat});
-  }
-}
 
 // A closed room of 4 x 4 x 3 m inside, walls 0.4 m thick, on a lattice of
 // 0.1 m: thin enough that the coarse levels hold wall and room in one voxel.
@@ -232,7 +197,12 @@ void run_view(const View& v, int paths, const char* dir, bool with_vulkan) {
 }  // namespace
 
 void gi_images(int paths, const char* dir, bool with_vulkan) {
-  const World tunnel = main_job_tunnel();
+  Result<World> dug = main_job_tunnel();
+  if (!dug.ok()) {
+    std::printf("main job's tunnel failed: %s\n", dug.status().message().c_str());
+    return;
+  }
+  const World& tunnel = dug.value();
   const World room = closed_room();
   GiLights sky;
   sky.sky = default_sky();
