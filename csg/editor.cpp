@@ -177,8 +177,15 @@ Result<EditReceipt> WorldEditor::apply_batch(std::span<const Edit> edits, Contex
   Status s = check_boolean_config(config_);
   if (!s.ok()) return s;
   // Rasterize every brush first: any error leaves the world untouched.
+  // Reported from the start (issue 24: a large brush rasterized for minutes
+  // with nothing shown); rasterize_brush itself reports nothing inside one brush.
   std::vector<Result<PreparedEdit>> prepared_or(edits.size(), Status(ErrorCode::kInternal, "not run"));
-  tbb::parallel_for(size_t{0}, edits.size(), [&](size_t i) { prepared_or[i] = prepare_edit(edits[i], world_); });
+  if (ctx) ctx->report_progress("rasterize", 0.0);
+  detail::ProgressCounter rasterized(ctx, "rasterize", edits.size());
+  tbb::parallel_for(size_t{0}, edits.size(), [&](size_t i) {
+    prepared_or[i] = prepare_edit(edits[i], world_);
+    rasterized.step();
+  });
   std::vector<PreparedEdit> prepared;
   prepared.reserve(edits.size());
   for (size_t i = 0; i < edits.size(); ++i) {

@@ -2,6 +2,7 @@
 // allocated before the sizes that justify it have been checked against the file.
 #include "ldc/io.h"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
@@ -14,6 +15,7 @@
 #include <zstd.h>
 
 #include "ldc/detail/crc32.h"
+#include "ldc/internal/validate_work.h"
 
 namespace ldc {
 namespace {
@@ -109,7 +111,7 @@ void write_family(Writer& w, const RayFamily& f, int c) {
   }
   w.u8(0);
   for (uint64_t word : f.inside_bits()) w.u64(word);
-  for (int r = 0; r < c * c; ++r) w.u16(uint16_t(f.points(r).size()));
+  for (int r = 0; r < c * c; ++r) w.u16(uint16_t(f.point_count(r)));
   for (const PackedPoint& p : f.all_points()) {
     w.u16(p.depth);
     w.u16(p.material);
@@ -309,6 +311,7 @@ Status load_chunks(const uint8_t* payload, const std::vector<ChunkRecord>& table
   Status first_error;
   std::atomic<bool> failed{false};
   std::atomic<size_t> done{0};
+  const size_t report_every = std::max<size_t>(1, table.size() / 256);
   tbb::parallel_for(size_t{0}, table.size(), [&](size_t i) {
     if (failed.load() || (ctx && ctx->cancelled())) return;
     const ChunkRecord& rec = table[i];
@@ -317,8 +320,10 @@ Status load_chunks(const uint8_t* payload, const std::vector<ChunkRecord>& table
                        glm::ivec3(int(i % size_t(d.x)), int((i / size_t(d.x)) % size_t(d.y)),
                                   int(i / (size_t(d.x) * size_t(d.y))));
     Status s;
-    if (rec.kind != uint8_t(ChunkKind::kMixed)) {
-      world.set_uniform_chunk(coord, rec.kind == uint8_t(ChunkKind::kSolid));
+    if (rec.kind == uint8_t(ChunkKind::kEmpty)) {
+      // World::create left the slot empty: nothing to store (nor a stamp to renew).
+    } else if (rec.kind == uint8_t(ChunkKind::kSolid)) {
+      world.set_uniform_chunk(coord, true);
     } else {
       std::string at = "chunk (" + std::to_string(coord.x) + "," + std::to_string(coord.y) + "," +
                        std::to_string(coord.z) + ")";
@@ -347,7 +352,9 @@ Status load_chunks(const uint8_t* payload, const std::vector<ChunkRecord>& table
       if (!failed.exchange(true)) first_error = s;
     }
     size_t n = done.fetch_add(1) + 1;
-    if (ctx && n % 64 == 0) ctx->report_progress("load", double(n) / double(table.size()));
+    if (ctx && (n % report_every == 0 || n == table.size())) {
+      ctx->report_progress("load", double(n) / double(table.size()));
+    }
   });
   if (failed.load()) return first_error;
   if (ctx && ctx->cancelled()) return {ErrorCode::kCancelled, std::string(name) + ": load cancelled"};
@@ -356,8 +363,13 @@ Status load_chunks(const uint8_t* payload, const std::vector<ChunkRecord>& table
 
 }  // namespace
 
-Result<std::vector<uint8_t>> serialize_world(const World& world, const SaveOptions& options,
-                                             Context* ctx) {
+namespace {
+
+// Reports ("save", fraction) as chunks are compressed, up to `last_fraction`:
+// save_world reports 100% only once the file is written (issue 24: 'save
+// 100%' was printed before the write, and then an error).
+Result<std::vector<uint8_t>> serialize_with_progress(const World& world, const SaveOptions& options,
+                                                     Context* ctx, double last_fraction) {
   if (options.compression_level < 1 || options.compression_level > 19) {
     return Status(ErrorCode::kInvalidArgument,
                   "save: compression_level = " + std::to_string(options.compression_level) + " must be in 1 .. 19");
@@ -366,15 +378,22 @@ Result<std::vector<uint8_t>> serialize_world(const World& world, const SaveOptio
   world.for_each_chunk([&](const glm::ivec3& c, ChunkKind k, const Chunk* d) { slots.emplace_back(c, k, d); });
   std::vector<std::vector<uint8_t>> frames(slots.size());
   std::vector<uint32_t> raw_sizes(slots.size(), 0);
+  if (ctx) ctx->report_progress("save", 0.0);
+  std::atomic<size_t> done{0};
+  const size_t report_every = std::max<size_t>(1, slots.size() / 256);
   tbb::parallel_for(size_t{0}, slots.size(), [&](size_t i) {
-    const Chunk* d = std::get<2>(slots[i]);
-    if (!d) return;
-    std::vector<uint8_t> raw = chunk_raw_bytes(*d, world.chunk_size());
-    raw_sizes[i] = uint32_t(raw.size());
-    frames[i].resize(ZSTD_compressBound(raw.size()));
-    size_t n = ZSTD_compress(frames[i].data(), frames[i].size(), raw.data(), raw.size(),
-                             options.compression_level);
-    frames[i].resize(ZSTD_isError(n) ? 0 : n);
+    if (const Chunk* d = std::get<2>(slots[i])) {
+      std::vector<uint8_t> raw = chunk_raw_bytes(*d, world.chunk_size());
+      raw_sizes[i] = uint32_t(raw.size());
+      frames[i].resize(ZSTD_compressBound(raw.size()));
+      size_t n = ZSTD_compress(frames[i].data(), frames[i].size(), raw.data(), raw.size(),
+                               options.compression_level);
+      frames[i].resize(ZSTD_isError(n) ? 0 : n);
+    }
+    const size_t finished = done.fetch_add(1, std::memory_order_relaxed) + 1;
+    if (ctx && finished % report_every == 0) {
+      ctx->report_progress("save", last_fraction * 0.9 * double(finished) / double(slots.size()));
+    }
   });
   Header h;
   h.config = world.config();
@@ -403,16 +422,25 @@ Result<std::vector<uint8_t>> serialize_world(const World& world, const SaveOptio
   out.raw(table.bytes.data(), table.bytes.size());
   out.u32(detail::crc32(table.bytes.data(), table.bytes.size()));
   for (const auto& f : frames) out.raw(f.data(), f.size());
-  if (ctx) ctx->report_progress("save", 1.0);
+  if (ctx) ctx->report_progress("save", last_fraction);
   return std::move(out.bytes);
+}
+
+}  // namespace
+
+Result<std::vector<uint8_t>> serialize_world(const World& world, const SaveOptions& options,
+                                             Context* ctx) {
+  return serialize_with_progress(world, options, ctx, 1.0);
 }
 
 Status save_world(const World& world, const std::string& path, const SaveOptions& options,
                   Context* ctx) {
-  Result<std::vector<uint8_t>> bytes = serialize_world(world, options, ctx);
+  Result<std::vector<uint8_t>> bytes = serialize_with_progress(world, options, ctx, 0.95);
   if (!bytes.ok()) return bytes.status();
   const std::vector<uint8_t>& b = bytes.value();
-  return write_file_atomically(path, std::string_view(reinterpret_cast<const char*>(b.data()), b.size()));
+  Status s = write_file_atomically(path, std::string_view(reinterpret_cast<const char*>(b.data()), b.size()));
+  if (s.ok() && ctx) ctx->report_progress("save", 1.0);
+  return s;
 }
 
 Result<World> deserialize_world(std::string_view bytes, std::string_view name,
@@ -452,6 +480,7 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
     if (!checksum_matches(tp, h.table_bytes, section_crc(tp + h.table_bytes))) {
       return corrupt(name, "chunk table checksum mismatch");
     }
+    if (ctx) ctx->report_progress("load", 0.0);
     std::vector<ChunkRecord> table;
     s = parse_table(tp, slots, h.payload_bytes, name, limits, table);
     if (!s.ok()) return s;
@@ -459,7 +488,7 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
     if (!s.ok()) return s;
     if (world.stats().points != h.total_points) return corrupt(name, "point count disagrees with the header");
     if (!limits.validate_world) return world;
-    ValidationReport v = validate(world, {.check_cross_axis = false, .max_messages = 1});
+    ValidationReport v = detail::validate_with_progress(world, {.check_cross_axis = false, .max_messages = 1}, ctx);
     if (!v.ok) return corrupt(name, v.messages.empty() ? "invalid world" : v.messages.front());
     return world;
   } catch (const std::bad_alloc&) {
@@ -468,6 +497,7 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
 }
 
 Result<World> load_world(const std::string& path, const LoadLimits& limits, Context* ctx) {
+  if (ctx) ctx->report_progress("read", 0.0);
   Result<std::string> bytes = read_file(path, limits.max_file_bytes);
   if (!bytes.ok()) return bytes.status();
   return deserialize_world(bytes.value(), path, limits, ctx);

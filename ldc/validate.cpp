@@ -1,15 +1,19 @@
 // validate(): every invariant of the LDC, checked chunk by chunk in parallel.
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <bit>
 #include <tuple>
 #include <cmath>
 #include <mutex>
+#include <span>
 #include <sstream>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "ldc/internal/ray_math.h"
+#include "ldc/internal/validate_work.h"
 #include "ldc/world.h"
 
 namespace ldc {
@@ -31,6 +35,9 @@ class ErrorSink {
     messages_.push_back(std::move(message));
   }
   size_t count() const { return count_.load(); }
+  // Work counters (detail::ValidateWork).
+  std::atomic<size_t> rays_visited{0};
+  std::atomic<size_t> uniform_faces{0};
   std::vector<std::string> take() { return std::move(messages_); }
 
  private:
@@ -66,12 +73,15 @@ bool check_family_arrays(const RayFamily& f, int c, const glm::ivec3& coord, int
 
 // Order, range, sense and normals of one ray segment. Messages are built only
 // for errors: this runs for every ray of every mixed chunk.
-void check_ray(const RayFamily& f, int axis, int ray, int c, const glm::ivec3& coord,
-               ErrorSink& sink) {
+// `pts` are the ray's points: callers walk the family's rays in order and
+// slice all_points() by point_count(), so a ray costs its own points, not the
+// O(C) offset sum RayFamily::points() makes (issue 24: a 277 MB world took
+// 41 s to load, most of it summing row offsets).
+void check_ray(const RayFamily& f, std::span<const PackedPoint> pts, int axis, int ray, int c,
+               const glm::ivec3& coord, ErrorSink& sink) {
   const uint32_t q = depth_steps_per_cell(c);
   bool expect_enter = !f.starts_inside(ray);
   uint32_t prev = 0;
-  auto pts = f.points(ray);
   auto fail = [&](size_t i, const std::string& what) {
     sink.add(where(coord, axis, ray) + " point " + std::to_string(i) + ": " + what);
   };
@@ -98,7 +108,12 @@ void check_ray(const RayFamily& f, int axis, int ray, int c, const glm::ivec3& c
 // Node words of one family in the X layout: out[z*64 + y], bit x.
 void family_node_words(const RayFamily& f, int axis, int c, std::vector<uint64_t>& out) {
   std::vector<uint64_t> fam(size_t(c) * c);
-  for (int r = 0; r < c * c; ++r) fam[r] = detail::node_word(f.starts_inside(r), f.points(r), c);
+  const PackedPoint* p = f.all_points().data();
+  for (int r = 0; r < c * c; ++r) {
+    const uint32_t n = f.point_count(r);
+    fam[r] = detail::node_word(f.starts_inside(r), std::span<const PackedPoint>(p, n), c);
+    p += n;
+  }
   out.assign(size_t(c) * 64, 0);
   detail::convert_layout(axis, c, fam.data(), out.data(), false);
 }
@@ -129,25 +144,35 @@ void check_chunk(const Chunk& chunk, const glm::ivec3& coord, int c, bool cross_
       arrays_ok = false;
       continue;
     }
-    if (chunk.axis[a].is_uniform()) continue;
-    for (int r = 0; r < c * c; ++r) check_ray(chunk.axis[a], a, r, c, coord, sink);
+    const RayFamily& f = chunk.axis[a];
+    if (f.is_uniform()) continue;
+    const PackedPoint* p = f.all_points().data();
+    for (int r = 0; r < c * c; ++r) {
+      const uint32_t n = f.point_count(r);
+      check_ray(f, std::span<const PackedPoint>(p, n), a, r, c, coord, sink);
+      p += n;
+    }
+    sink.rays_visited.fetch_add(size_t(c) * size_t(c), std::memory_order_relaxed);
   }
   if (arrays_ok && cross_axis) check_cross_axis(chunk, c, coord, sink);
 }
 
-// End state of a ray segment: start state flipped once per point.
-bool segment_ends_inside(const World& w, const glm::ivec3& ch, int axis, int ray) {
-  ChunkKind kind = w.chunk_kind(ch);
-  if (kind != ChunkKind::kMixed) return kind == ChunkKind::kSolid;
-  const RayFamily& f = w.chunk(ch)->axis[axis];
-  return f.starts_inside(ray) != (f.points(ray).size() % 2 == 1);
-}
-
-bool segment_starts_inside(const World& w, const glm::ivec3& ch, int axis, int ray) {
-  ChunkKind kind = w.chunk_kind(ch);
-  if (kind != ChunkKind::kMixed) return kind == ChunkKind::kSolid;
-  return w.chunk(ch)->axis[axis].starts_inside(ray);
-}
+// One side of a chunk boundary: the chunk's family along the axis, or its
+// uniform state, looked up once per face instead of once per ray.
+struct FaceSide {
+  const RayFamily* family = nullptr;  // null: uniform slot (or outside the box)
+  bool solid = false;
+  FaceSide(const World& w, const glm::ivec3& ch, int axis) {
+    ChunkKind kind = w.chunk_kind(ch);
+    if (kind == ChunkKind::kMixed) family = &w.chunk(ch)->axis[axis];
+    solid = kind == ChunkKind::kSolid;
+  }
+  bool starts_inside(int ray) const { return family ? family->starts_inside(ray) : solid; }
+  // End state of a ray segment: start state flipped once per point.
+  bool ends_inside(int ray) const {
+    return family ? family->starts_inside(ray) != (family->point_count(ray) % 2 == 1) : solid;
+  }
+};
 
 // Continuity between two uniform chunk slots: every ray of the face is alike,
 // so one comparison stands for all C^2 (issue 24: an all-empty world of
@@ -172,14 +197,17 @@ void check_continuity(const World& w, const glm::ivec3& ch, ErrorSink& sink) {
     next[a] += 1;
     if (w.chunk_kind(ch) != ChunkKind::kMixed && w.chunk_kind(next) != ChunkKind::kMixed) {
       check_uniform_face(w, ch, a, next, sink);
+      sink.uniform_faces.fetch_add(1, std::memory_order_relaxed);
       continue;
     }
     bool first_in_box = ch[a] == w.chunk_origin()[a];
+    const FaceSide here(w, ch, a), there(w, next, a);
+    sink.rays_visited.fetch_add(size_t(c) * size_t(c), std::memory_order_relaxed);
     for (int r = 0; r < c * c; ++r) {
-      if (first_in_box && segment_starts_inside(w, ch, a, r)) {
+      if (first_in_box && here.starts_inside(r)) {
         sink.add(where(ch, a, r) + ": ray starts inside at the world box face");
       }
-      if (segment_ends_inside(w, ch, a, r) != segment_starts_inside(w, next, a, r)) {
+      if (here.ends_inside(r) != there.starts_inside(r)) {
         sink.add(where(ch, a, r) + ": ray state breaks at the boundary to the next chunk");
       }
     }
@@ -211,25 +239,51 @@ std::string ValidationReport::summary() const {
 }
 
 ValidationReport validate(const World& world, const ValidateOptions& options) {
+  return detail::validate_with_progress(world, options, nullptr);
+}
+
+namespace detail {
+
+ValidationReport validate_with_progress(const World& world, const ValidateOptions& options, Context* ctx,
+                                        ValidateWork* work) {
   ErrorSink sink(options.max_messages);
-  std::vector<std::tuple<glm::ivec3, ChunkKind, const Chunk*>> slots;
-  world.for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk* data) {
-    slots.emplace_back(ch, kind, data);
-  });
+  // Slots by index, in slot order (x fastest): no list of all slots is built
+  // (4M slots made a 100 MB one).
+  const glm::ivec3 d = world.chunk_dims();
+  const size_t slots = size_t(d.x) * size_t(d.y) * size_t(d.z);
+  if (ctx) ctx->report_progress("validate", 0.0);
   std::atomic<size_t> mixed{0};
-  tbb::parallel_for(size_t{0}, slots.size(), [&](size_t i) {
-    auto [ch, kind, data] = slots[i];
-    if (kind == ChunkKind::kMixed) mixed.fetch_add(1);
-    check_slot(world, ch, kind, data, options.check_cross_axis, sink);
+  std::atomic<size_t> done{0};
+  const size_t grain = std::max<size_t>(1, slots / 1024);
+  tbb::parallel_for(tbb::blocked_range<size_t>(0, slots, grain), [&](const tbb::blocked_range<size_t>& range) {
+    size_t mixed_here = 0;
+    for (size_t i = range.begin(); i != range.end(); ++i) {
+      const glm::ivec3 ch = world.chunk_origin() + glm::ivec3(int(i % size_t(d.x)), int((i / size_t(d.x)) % size_t(d.y)),
+                                                               int(i / (size_t(d.x) * size_t(d.y))));
+      const ChunkKind kind = world.chunk_kind(ch);
+      mixed_here += kind == ChunkKind::kMixed;
+      check_slot(world, ch, kind, world.chunk(ch), options.check_cross_axis, sink);
+    }
+    mixed.fetch_add(mixed_here, std::memory_order_relaxed);
+    const size_t n = done.fetch_add(range.size(), std::memory_order_relaxed) + range.size();
+    if (ctx && n < slots) ctx->report_progress("validate", double(n) / double(slots));
   });
+  if (ctx) ctx->report_progress("validate", 1.0);
   ValidationReport report;
   report.errors = sink.count();
   report.ok = report.errors == 0;
   report.messages = sink.take();
   const size_t c = size_t(world.chunk_size());
   report.nodes_checked = options.check_cross_axis ? mixed.load() * c * c * c : 0;
+  if (work) {
+    work->slots += slots;
+    work->rays_visited += sink.rays_visited.load();
+    work->uniform_faces += sink.uniform_faces.load();
+  }
   return report;
 }
+
+}  // namespace detail
 
 Status validate_chunk(const Chunk& chunk, int chunk_size, bool check_cross_axis) {
   ErrorSink sink(1);

@@ -444,11 +444,14 @@ std::vector<Span> World::ray_spans(int axis, const glm::ivec2& uv) const {
 namespace {
 
 // Inside length (cells) of one ray segment of a chunk.
-double segment_inside_length(const RayFamily& f, int ray, int chunk_size) {
+// `points` are the ray's: callers walk rays in order, slicing all_points()
+// by point_count() (RayFamily::points sums a row's counts: O(C) per ray).
+double segment_inside_length(const RayFamily& f, std::span<const PackedPoint> points, int ray,
+                             int chunk_size) {
   const double steps = depth_steps_per_cell(chunk_size);
   bool in = f.starts_inside(ray);
   double last = 0.0, sum = 0.0;
-  for (const PackedPoint& p : f.points(ray)) {
+  for (const PackedPoint& p : points) {
     double d = p.depth / steps;
     if (in) sum += d - last;
     last = d;
@@ -468,7 +471,12 @@ double World::volume(int axis) const {
     if (kinds_[slot] == ChunkKind::kSolid) cells += double(c) * c * c;
     if (kinds_[slot] != ChunkKind::kMixed) continue;
     const RayFamily& f = chunks_[slot]->axis[axis];
-    for (int r = 0; r < c * c; ++r) cells += segment_inside_length(f, r, c);
+    const PackedPoint* p = f.all_points().data();
+    for (int r = 0; r < c * c; ++r) {
+      const uint32_t n = f.point_count(r);
+      cells += segment_inside_length(f, std::span<const PackedPoint>(p, n), r, c);
+      p += n;
+    }
   }
   return cells * h * h * h;
 }
@@ -485,8 +493,12 @@ std::optional<WorldBox> World::solid_bounds() const {
     if (!data) return;
     for (int a = 0; a < 3; ++a) {
       const RayFamily& f = data->axis[a];
+      const PackedPoint* first = f.all_points().data();
       for (int r = 0; r < c * c; ++r) {
-        for (const PackedPoint& p : f.points(r)) {
+        const uint32_t n = f.point_count(r);
+        const std::span<const PackedPoint> points(first, n);
+        first += n;
+        for (const PackedPoint& p : points) {
           glm::dvec3 q = detail::point_lattice_position(ch, a, r, p.depth, c);
           lo = glm::min(lo, q);
           hi = glm::max(hi, q);

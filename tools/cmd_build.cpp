@@ -146,10 +146,11 @@ int run_build(const BuildArgs& a, const CommonOptions& common) {
   bar.finish();
   if (!w.ok()) return fail("build", w.status());
   // Validated before the save: an invalid world is never written (exit 2).
-  nlohmann::json info = world_info_json(w.value(), a.validate);
+  nlohmann::json info = world_info_json(w.value(), a.validate, bar.context());
   if (refuse_invalid_world("build", info, a.output)) return kExitInvalid;
   const bool empty = warn_if_rasterized_empty("build", w.value(), input_name(a), mesh_mode(a));
   Status s = save_world(w.value(), a.output, {}, bar.context());
+  bar.finish();
   if (!s.ok()) return fail("build", s);
   nlohmann::json out = {{"output", a.output}, {"empty", empty}, {"build", report_json(report)}, {"info", info}};
   out["build"]["stages"] = stage_seconds(*bar.context());

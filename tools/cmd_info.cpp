@@ -19,9 +19,9 @@ int run_info(const InfoArgs& a, const CommonOptions& common) {
   LoadLimits limits;
   limits.validate_world = !a.no_validate;  // --no-validate skips every optional check, the loader's too
   Result<World> w = load_world(a.input, limits, bar.context());
-  bar.finish();
   if (!w.ok()) return fail("info", w.status());
-  nlohmann::json info = world_info_json(w.value(), !a.no_validate);
+  nlohmann::json info = world_info_json(w.value(), !a.no_validate, bar.context());
+  bar.finish();
   info["file"] = a.input;
   if (common.json) std::printf("%s\n", json_text(info).c_str());
   else std::printf("file        %s\n%s", a.input.c_str(), world_info_text(info).c_str());

@@ -35,9 +35,10 @@ int run_terrain(TerrainArgs a, const CommonOptions& common) {
   Result<World> w = build_terrain(a.config, a.cell_size, a.chunk, bar.context(), &report);
   bar.finish();
   if (!w.ok()) return fail("terrain", w.status());
-  nlohmann::json info = world_info_json(w.value(), a.validate);
+  nlohmann::json info = world_info_json(w.value(), a.validate, bar.context());
   if (refuse_invalid_world("terrain", info, a.output)) return kExitInvalid;  // never written
-  Status s = save_world(w.value(), a.output);
+  Status s = save_world(w.value(), a.output, {}, bar.context());
+  bar.finish();
   if (!s.ok()) return fail("terrain", s);
   if (common.json) {
     std::printf("%s\n", json_text({{"output", a.output}, {"seconds", report.seconds}, {"info", info}}).c_str());

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <atomic>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -12,45 +13,96 @@
 
 #include <tbb/global_control.h>
 
+#include "ldc/internal/validate_work.h"
 #include "ldc/internal/vec_text.h"
 
 namespace ldc::tool {
 
+namespace {
+// The bar of the running command (one per process), ended before a message.
+std::atomic<ProgressBar*> active_bar{nullptr};
+}  // namespace
+
 ProgressBar::ProgressBar(bool enabled)
     : enabled_(enabled), tty_(isatty(STDERR_FILENO)), start_(std::chrono::steady_clock::now()) {
   if (!enabled_) return;
-  ctx_.set_progress([this](std::string_view stage, double fraction) { draw(stage, fraction); });
+  ctx_.set_progress([this](std::string_view stage, double fraction) { report(stage, fraction); });
+  ProgressBar* none = nullptr;
+  active_bar.compare_exchange_strong(none, this);
+  ticker_ = std::thread([this] { tick(); });
 }
 
-ProgressBar::~ProgressBar() { finish(); }
+ProgressBar::~ProgressBar() {
+  if (ticker_.joinable()) {
+    {
+      std::lock_guard<std::mutex> lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_all();
+    ticker_.join();
+  }
+  ProgressBar* self = this;
+  active_bar.compare_exchange_strong(self, nullptr);
+  finish();
+}
 
-void ProgressBar::draw(std::string_view stage, double fraction) {
-  double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+void ProgressBar::report(std::string_view stage, double fraction) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  active_ = true;
+  stage_.assign(stage);
+  fraction_ = fraction;
+  draw_locked();
+}
+
+void ProgressBar::tick() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  while (!stop_) {
+    wake_.wait_for(lock, std::chrono::milliseconds(500));
+    if (!stop_ && active_) draw_locked();
+  }
+}
+
+void ProgressBar::draw_locked() {
+  const auto now = std::chrono::steady_clock::now();
+  double elapsed = std::chrono::duration<double>(now - start_).count();
   if (elapsed < 1.0) return;  // short work gets no bar
-  int decile = int(fraction * 10.0);
-  if (!tty_ && stage == last_stage_ && decile == last_decile_) return;
-  last_stage_ = std::string(stage);
+  int decile = int(fraction_ * 10.0), percent = int(fraction_ * 100.0);
+  if (!tty_ && stage_ == last_stage_ && decile == last_decile_) return;
+  // On a terminal: a new stage or percentage at once, the time at most 5 times a second.
+  if (tty_ && stage_ == last_stage_ && percent == last_percent_ && now - last_draw_ < std::chrono::milliseconds(200)) return;
+  last_stage_ = stage_;
   last_decile_ = decile;
+  last_percent_ = percent;
+  last_draw_ = now;
   const int width = 30;
-  int filled = int(std::lround(fraction * width));
+  int filled = int(std::lround(fraction_ * width));
   std::string bar(size_t(filled), '#');
   bar.resize(width, '.');
-  std::fprintf(stderr, "%s%-10.*s [%s] %3d%%  %.1fs%s", tty_ ? "\r" : "", int(stage.size()),
-               stage.data(), bar.c_str(), int(fraction * 100.0), elapsed, tty_ ? "" : "\n");
+  std::fprintf(stderr, "%s%-10.*s [%s] %3d%%  %.1fs%s", tty_ ? "\r" : "", int(stage_.size()),
+               stage_.data(), bar.c_str(), int(fraction_ * 100.0), elapsed, tty_ ? "" : "\n");
   std::fflush(stderr);
   drawn_ = true;
 }
 
 void ProgressBar::finish() {
+  std::lock_guard<std::mutex> lock(mutex_);
   if (drawn_ && tty_) std::fprintf(stderr, "\n");
   drawn_ = false;
+  active_ = false;
 }
+
+namespace {
+void end_progress_line() {
+  if (ProgressBar* bar = active_bar.load()) bar->finish();
+}
+}  // namespace
 
 int fail(const std::string& command, const Status& status) {
   return fail(command, status.to_string());
 }
 
 int fail(const std::string& command, const std::string& message) {
+  end_progress_line();
   std::fprintf(stderr, "ldc %s: %s\n", command.c_str(), message.c_str());
   return 1;
 }
@@ -65,6 +117,7 @@ std::vector<std::string> printed_warnings;  // the tool is one command per proce
 }  // namespace
 
 void warn(const std::string& command, const std::string& message) {
+  end_progress_line();
   std::fprintf(stderr, "ldc %s: warning: %s\n", command.c_str(), message.c_str());
   printed_warnings.push_back(message);
 }
@@ -115,7 +168,7 @@ bool parse_vec3(const std::string& text, glm::dvec3* out) {
   return true;
 }
 
-nlohmann::json world_info_json(const World& world, bool run_validate) {
+nlohmann::json world_info_json(const World& world, bool run_validate, Context* ctx) {
   nlohmann::json j;
   const WorldStats s = world.stats();
   const Lattice& lat = world.lattice();
@@ -137,12 +190,13 @@ nlohmann::json world_info_json(const World& world, bool run_validate) {
   nlohmann::json meta = nlohmann::json::object();
   for (const auto& [k, v] : world.metadata()) meta[k] = v;
   j["metadata"] = meta;
-  if (run_validate) j["validation"] = validation_json(world);
+  if (run_validate) j["validation"] = validation_json(world, ctx);
   return j;
 }
 
-nlohmann::json validation_json(const World& world) {
-  ValidationReport r = validate(world);
+nlohmann::json validation_json(const World& world, Context* ctx) {
+  // Reported as the stage 'validate' (issue 24: 36 s of it went unshown).
+  ValidationReport r = detail::validate_with_progress(world, {}, ctx);
   return {{"ok", r.ok}, {"errors", r.errors}, {"nodes_checked", r.nodes_checked}, {"messages", r.messages}};
 }
 
@@ -182,6 +236,7 @@ std::string world_info_text(const nlohmann::json& j) {
 
 bool refuse_invalid_world(const std::string& command, const nlohmann::json& info, const std::string& output) {
   if (!info.contains("validation") || info["validation"]["ok"].get<bool>()) return false;
+  end_progress_line();
   std::fprintf(stderr, "ldc %s: the world is invalid; %s not written\n%s", command.c_str(), output.c_str(),
                validation_text(info["validation"]).c_str());
   return true;

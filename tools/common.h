@@ -14,8 +14,12 @@
 #pragma once
 
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <string_view>
+#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -46,23 +50,40 @@ extern const char* const kExitStatusHelp;
 
 // A Context whose progress callback draws a bar on stderr once the work has
 // taken more than a second (redrawn in place on a terminal, one line per 10%
-// otherwise).
+// otherwise). A ticker thread redraws the current stage every half second, so
+// a stage that reports nothing for a while still shows its time running
+// (issue 24: 'load 90%' sat still through 36 s of validation). fail() and
+// warn() end the bar's line before printing (an error was glued onto it).
 class ProgressBar {
  public:
   explicit ProgressBar(bool enabled);
   ~ProgressBar();
+  ProgressBar(const ProgressBar&) = delete;
+  ProgressBar& operator=(const ProgressBar&) = delete;
   Context* context() { return &ctx_; }
+  // Ends the bar's line; a later report starts a new one.
   void finish();
 
  private:
-  void draw(std::string_view stage, double fraction);
+  void report(std::string_view stage, double fraction);
+  void draw_locked();
+  void tick();
   Context ctx_;
   bool enabled_;
   bool tty_;
+  std::mutex mutex_;  // guards everything below
+  std::condition_variable wake_;
+  bool stop_ = false;
+  bool active_ = false;  // a stage reported since the last finish()
+  std::string stage_;
+  double fraction_ = 0.0;
   bool drawn_ = false;
   int last_decile_ = -1;
   std::string last_stage_;
+  int last_percent_ = -1;
   std::chrono::steady_clock::time_point start_;
+  std::chrono::steady_clock::time_point last_draw_{};
+  std::thread ticker_;
 };
 
 // Prints "ldc <command>: <message>" on stderr; returns the exit status for it.
@@ -123,12 +144,12 @@ bool parse_numbers(const std::string& text, std::vector<double>* out);
 bool parse_vec3(const std::string& text, glm::dvec3* out);
 
 // The world's statistics and validation as JSON (what `ldc info --json` prints).
-nlohmann::json world_info_json(const World& world, bool run_validate);
+nlohmann::json world_info_json(const World& world, bool run_validate, Context* ctx = nullptr);
 // The same, as human-readable lines.
 std::string world_info_text(const nlohmann::json& info);
 
 // validate() as JSON {"ok", "errors", "nodes_checked", "messages"}, and as text.
-nlohmann::json validation_json(const World& world);
+nlohmann::json validation_json(const World& world, Context* ctx = nullptr);
 std::string validation_text(const nlohmann::json& validation);
 
 // --validate before a save: when `info` (world_info_json with validation)
