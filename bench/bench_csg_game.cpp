@@ -3,8 +3,13 @@
 // chunks they dirtied (ChunkedMesh::update), at 1 and 2 threads and chunk sizes
 // 16 and 32; then 1,000 random digs with time per edit and memory.
 //
-// Usage: bench_csg_game [--quick]
+// Usage: bench_csg_game [--quick | --dig [runs]]
+//   --dig: only the 2 m sphere dig + re-mesh (C = 32, LiveConfig's contour
+//   config), median and p95 over `runs` (default 101) at 1 and 2 threads.
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <random>
 #include <string>
@@ -141,9 +146,43 @@ void stress_table(bool quick) {
   std::printf("\nvalidate() after the digs: %s\n", valid ? "ok" : "FAILED");
 }
 
+// The budget row alone, with its spread: median and p95 of edit + re-mesh.
+void dig_table(int runs) {
+  std::printf("\n## 2 m sphere dig + re-mesh (h = 0.2 m, C = 32, untangle off), %d runs\n\n", runs);
+  std::printf("| threads | edit ms median | edit + re-mesh ms median | p95 | min |\n|---|---|---|---|---|\n");
+  ldc::World w = ldc::build_terrain({}, 0.2, 32).value();
+  for (int threads : {1, 2}) {
+    tbb::global_control gc(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    ldc::WorldEditor ed(w);
+    ldc::ChunkedMesh meshes({.untangle = false});
+    if (!meshes.build(ed.world()).ok()) std::abort();
+    const GameEdit dig = game_edits(w).front();
+    std::vector<double> edit, total;
+    for (int r = 0; r < runs; ++r) {
+      auto t0 = std::chrono::steady_clock::now();
+      ldc::EditReceipt receipt = ed.apply(dig.brush, dig.op).value();
+      auto t1 = std::chrono::steady_clock::now();
+      (void)meshes.update(ed.world(), ed.take_dirty()).value();
+      auto t2 = std::chrono::steady_clock::now();
+      edit.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      total.push_back(std::chrono::duration<double, std::milli>(t2 - t0).count());
+      if (!ed.undo(receipt).ok()) std::abort();
+      (void)meshes.update(ed.world(), ed.take_dirty()).value();
+    }
+    std::sort(edit.begin(), edit.end());
+    std::sort(total.begin(), total.end());
+    std::printf("| %d | %.2f | %.2f | %.2f | %.2f |\n", threads, edit[edit.size() / 2], total[total.size() / 2],
+                total[size_t(0.95 * double(total.size() - 1))], total.front());
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "--dig") == 0) {
+    dig_table(argc > 2 ? std::max(1, std::atoi(argv[2])) : 101);
+    return 0;
+  }
   bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   std::printf("# Brush edits\n\n");
   ldc::bench::print_machine();

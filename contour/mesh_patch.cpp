@@ -2,8 +2,8 @@
 #include "contour/detail/mesh_patch.h"
 
 #include <algorithm>
+#include <optional>
 
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -86,6 +86,21 @@ struct VertexSource {
   size_t index;  // into the patch's arrays or the old mesh's
 };
 
+// Patches up to this many cells per slab mesh with a mesher kept per thread,
+// so the re-mesh after a small edit allocates and faults in nothing (its
+// region's edge tables alone are about a megabyte); larger ones use a fresh
+// mesher, so no thread keeps a large edit's buffers.
+constexpr size_t kKeptMesherCells = size_t(64) * 64 * 64;
+
+// RegionMesher::mesh starts no parallel work, so no thread re-enters its
+// kept mesher through TBB's work stealing.
+RegionMesher& kept_mesher(const World& world, const ContourConfig& config) {
+  thread_local std::optional<RegionMesher> mesher;
+  if (mesher) mesher->rebind(world, config);
+  else mesher.emplace(world, config);
+  return *mesher;
+}
+
 }  // namespace
 
 void patch_box(const glm::ivec3& node_lo, const glm::ivec3& node_hi, int reach, glm::ivec3* lo, glm::ivec3* hi) {
@@ -100,12 +115,17 @@ MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm:
   const int slabs = std::max(1, std::min(tbb::this_task_arena::max_concurrency(), depth / 8));
   std::vector<ChunkMesh> pieces(static_cast<size_t>(slabs));
   std::vector<ContourStats> piece_stats(static_cast<size_t>(slabs));
-  tbb::enumerable_thread_specific<RegionMesher> meshers(RegionMesher(world, config));
+  const glm::ivec3 size = hi - lo;
+  const bool small = size_t(size.x) * size_t(size.y) * size_t(depth / slabs + 1) <= kKeptMesherCells;
   tbb::parallel_for(0, slabs, [&](int s) {
     glm::ivec3 a = lo, b = hi;
     a.z = lo.z + depth * s / slabs;
     b.z = lo.z + depth * (s + 1) / slabs;
-    meshers.local().mesh(a, b, pieces[size_t(s)], piece_stats[size_t(s)], /*order_triangles=*/false);
+    if (small) {
+      kept_mesher(world, config).mesh(a, b, pieces[size_t(s)], piece_stats[size_t(s)], /*order_triangles=*/false);
+    } else {
+      RegionMesher(world, config).mesh(a, b, pieces[size_t(s)], piece_stats[size_t(s)], /*order_triangles=*/false);
+    }
   });
   MeshPatch p;
   p.lo = lo;
@@ -141,10 +161,11 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   sources.clear();
   for (size_t t = 0; t < old.mesh.triangles.size(); ++t) {
     const glm::uvec3& i = old.mesh.triangles[t];
-    MeshPatch::Triangle tri{{old.vertex_cell[i.x], old.vertex_cell[i.y], old.vertex_cell[i.z]},
-                            {old.vertex_sheet[i.x], old.vertex_sheet[i.y], old.vertex_sheet[i.z]},
-                            old.mesh.triangle_material[t]};
-    if (!in_box(edge_node(tri.cell), patch.lo, patch.hi)) tris.push_back(tri);
+    const glm::ivec3 cells[3] = {old.vertex_cell[i.x], old.vertex_cell[i.y], old.vertex_cell[i.z]};
+    if (in_box(edge_node(cells), patch.lo, patch.hi)) continue;
+    tris.push_back({{cells[0], cells[1], cells[2]},
+                    {old.vertex_sheet[i.x], old.vertex_sheet[i.y], old.vertex_sheet[i.z]},
+                    old.mesh.triangle_material[t]});
   }
   for (const MeshPatch::Triangle& tri : patch.triangles) {
     if (in_box(edge_node(tri.cell), own_lo, own_hi)) tris.push_back(tri);
@@ -179,8 +200,9 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   // Copies of the neighbours' vertices the triangles use, in first-use order.
   CellIndex index(own_lo - 1, chunk_size + 1, 0);
   for (size_t v = 0; v < own; ++v) index.set(sources[v].cell, sources[v].sheet, int32_t(v));
+  // The old copies of neighbours' vertices: own cells are all in `index` already.
   CellIndex old_index(own_lo - 1, chunk_size + 1, 1);
-  for (size_t v = 0; v < old.vertex_cell.size(); ++v) {
+  for (size_t v = old.own_vertices; v < old.vertex_cell.size(); ++v) {
     if (old_index.contains(old.vertex_cell[v])) old_index.set(old.vertex_cell[v], old.vertex_sheet[v], int32_t(v));
   }
   ChunkMesh out;
@@ -209,6 +231,11 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
     out.mesh.triangle_material.push_back(tri.material);
   }
   out.own_vertices = own;
+  out.vertex_cell.reserve(sources.size());
+  out.vertex_sheet.reserve(sources.size());
+  out.mesh.positions.reserve(sources.size());
+  out.mesh.normals.reserve(sources.size());
+  out.mesh.vertex_material.reserve(sources.size());
   for (const VertexSource& s : sources) {
     out.vertex_cell.push_back(s.cell);
     out.vertex_sheet.push_back(s.sheet);

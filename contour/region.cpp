@@ -20,7 +20,7 @@ void Region::load(const World& world, const glm::ivec3& lo, const glm::ivec3& hi
   const size_t n = size_t(size_.x) * size_t(size_.y) * size_t(size_.z);
   signs_.assign(n, 0);
   for (auto& e : edge_) {
-    if (e.size() != n) e.assign(n, -1);
+    if (e.size() < n) e.resize(n, -1);  // all -1 after the clearing above: any prefix is clean
   }
   crossings_.clear();
   edges_with_crossing_.clear();

@@ -129,8 +129,9 @@ void RegionMesher::split(const Quad& q, int tri[2][3]) const {
 
 // The cells around every edge with a crossing get a vertex; the rest of the
 // region is never visited.
-std::vector<uint8_t> RegionMesher::cells_with_vertex() const {
-  std::vector<uint8_t> marked(size_t(cell_hi_.x - cell_lo_.x) * (cell_hi_.y - cell_lo_.y) * (cell_hi_.z - cell_lo_.z), 0);
+void RegionMesher::mark_cells_with_vertex() {
+  std::vector<uint8_t>& marked = marked_;
+  marked.assign(size_t(cell_hi_.x - cell_lo_.x) * (cell_hi_.y - cell_lo_.y) * (cell_hi_.z - cell_lo_.z), 0);
   for (const Region::EdgeRef& e : region_.crossing_edges()) {
     const glm::ivec3 eu = unit(axis_u(e.axis)), ev = unit(axis_v(e.axis));
     for (int k = 0; k < 4; ++k) {
@@ -140,7 +141,6 @@ std::vector<uint8_t> RegionMesher::cells_with_vertex() const {
       }
     }
   }
-  return marked;
 }
 
 // The crossings on the edges of one sheet of the cell, in a fixed order
@@ -168,7 +168,8 @@ CellPlanes RegionMesher::planes_of(const glm::ivec3& cell, const CellSheets& she
 // beyond them only cells with a border vertex are, as relaxation reads no
 // others. A cell's sheets get consecutive vertices.
 void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi) {
-  std::vector<uint8_t> marked = cells_with_vertex();
+  mark_cells_with_vertex();
+  const std::vector<uint8_t>& marked = marked_;
   cell_vertex_.assign(marked.size(), -1);
   cell_sheet_key_.assign(marked.size(), 0);
   verts_.clear();
@@ -180,6 +181,8 @@ void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& u
       for (int x = cell_lo_.x; x < cell_hi_.x; ++x, ++i) {
         if (!marked[i]) continue;
         const glm::ivec3 cell(x, y, z);
+        const bool used = in_box(cell, used_lo, used_hi);
+        if (!used && !has_mixed_crossings(cell)) continue;  // no sheet of it can be on a border
         const unsigned corners = inside_corners(cell);
         const unsigned joined = joined_faces(cell, corners);
         const CellSheets& sheets = cell_sheets(corners, joined);
@@ -188,13 +191,28 @@ void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& u
           planes[s] = planes_of(cell, sheets, s);
           any_border = any_border || planes[s].mixed_materials();
         }
-        if (!any_border && !in_box(cell, used_lo, used_hi)) continue;
+        if (!any_border && !used) continue;
         cell_vertex_[i] = int32_t(verts_.size());
         cell_sheet_key_[i] = uint16_t(corners | joined << 8);
         for (int s = 0; s < sheets.count; ++s) add_vertex(cell, s, planes[s]);
       }
     }
   }
+}
+
+// True when the crossings on the cell's edges have more than one material.
+bool RegionMesher::has_mixed_crossings(const glm::ivec3& cell) const {
+  int first = -1;
+  for (int a = 0; a < 3; ++a) {
+    const EdgeCrossing* edges[4];
+    region_.cell_edges(a, cell, edges);
+    for (const EdgeCrossing* e : edges) {
+      if (!e) continue;
+      if (first < 0) first = e->material;
+      else if (e->material != first) return true;
+    }
+  }
+  return false;
 }
 
 void RegionMesher::add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes) {
@@ -217,39 +235,55 @@ void RegionMesher::add_vertex(const glm::ivec3& cell, int sheet, const CellPlane
 // Elastic net on material borders: every border vertex moves towards the mean
 // of its border neighbours (cells sharing a quad edge with it), then back
 // towards its planes, and stays in its cell. Jacobi steps, so the result does
-// not depend on the order cells are visited in.
+// not depend on the order cells are visited in. The neighbours are found once:
+// iterations move vertices, never which vertices are neighbours.
 void RegionMesher::relax() {
   if (config_.relax_iterations <= 0 || config_.relax_strength <= 0.0) return;
-  std::vector<glm::dvec3> next(border_.size());
+  find_border_neighbours();
+  std::vector<glm::dvec3>& next = relax_next_;
+  next.resize(border_.size());
   for (int it = 0; it < config_.relax_iterations; ++it) {
-    for (size_t b = 0; b < border_.size(); ++b) next[b] = relaxed_position(verts_[border_[b]]);
+    for (size_t b = 0; b < border_.size(); ++b) next[b] = relaxed_position(b);
     for (size_t b = 0; b < border_.size(); ++b) verts_[border_[b]].x = next[b];
   }
 }
 
-// The elastic step, in the vertex's own cell frame: towards the mean of its
-// border neighbours, then back onto its planes (a few particle steps), and
-// into its cell.
-glm::dvec3 RegionMesher::relaxed_position(const CellVertex& v) const {
-  const glm::ivec3& cell = v.cell;
-  Quad quads[12];
-  int n = vertex_quads(v, quads);
-  glm::dvec3 sum(0.0);
-  int count = 0;
-  for (int k = 0; k < n; ++k) {
-    int at = 0;
-    while (quads[k].cell[at] != cell) ++at;
-    for (int side : {1, 3}) {
-      const glm::ivec3& other = quads[k].cell[(at + side) % 4];
-      if (!in_cell_box(other)) continue;
-      const CellVertex* nb = vertex(other, quads[k].sheet[(at + side) % 4]);
-      if (nb && nb->border) {
-        sum += glm::dvec3(other - cell) + nb->x;
-        ++count;
+// For each border vertex, its border neighbours in quad order, each once per
+// quad side that reaches it (as the mean counts them).
+void RegionMesher::find_border_neighbours() {
+  neighbour_begin_.assign(1, 0);
+  neighbours_.clear();
+  for (uint32_t vi : border_) {
+    const CellVertex& v = verts_[vi];
+    Quad quads[12];
+    const int n = vertex_quads(v, quads);
+    for (int k = 0; k < n; ++k) {
+      int at = 0;
+      while (quads[k].cell[at] != v.cell) ++at;
+      for (int side : {1, 3}) {
+        const glm::ivec3& other = quads[k].cell[(at + side) % 4];
+        if (!in_cell_box(other)) continue;
+        const int32_t nb = vertex_index(other, quads[k].sheet[(at + side) % 4]);
+        if (nb >= 0 && verts_[size_t(nb)].border) neighbours_.push_back(uint32_t(nb));
       }
     }
+    neighbour_begin_.push_back(uint32_t(neighbours_.size()));
   }
-  if (count == 0) return v.x;
+}
+
+// The elastic step of border vertex b, in the vertex's own cell frame:
+// towards the mean of its border neighbours, then back onto its planes (a few
+// particle steps), and into its cell.
+glm::dvec3 RegionMesher::relaxed_position(size_t b) const {
+  const CellVertex& v = verts_[border_[b]];
+  const uint32_t first = neighbour_begin_[b], last = neighbour_begin_[b + 1];
+  if (first == last) return v.x;
+  glm::dvec3 sum(0.0);
+  for (uint32_t k = first; k < last; ++k) {
+    const CellVertex& nb = verts_[neighbours_[k]];
+    sum += glm::dvec3(nb.cell - v.cell) + nb.x;
+  }
+  const int count = int(last - first);
   glm::dvec3 p = v.x + config_.relax_strength * (sum / double(count) - v.x);
   double planes = v.qef.a00 + v.qef.a11 + v.qef.a22;  // = number of planes
   for (int it = 0; it < 8 && planes > 0.0; ++it) {
@@ -262,7 +296,8 @@ glm::dvec3 RegionMesher::relaxed_position(const CellVertex& v) const {
 // found them (deterministic).
 void RegionMesher::emit(const glm::ivec3& own_lo, const glm::ivec3& own_hi, ChunkMesh& out,
                         ContourStats& stats, bool order_triangles) {
-  std::vector<int32_t> out_index(verts_.size(), -1);
+  std::vector<int32_t>& out_index = out_index_;
+  out_index.assign(verts_.size(), -1);
   ContourMesh& m = out.mesh;
   auto add_vertex = [&](size_t vi) {
     out_index[vi] = int32_t(m.positions.size());
@@ -325,7 +360,7 @@ void optimize_triangle_order(ContourMesh& m) {
 }
 
 void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
-  const Lattice& lat = world_.lattice();
+  const Lattice& lat = world_->lattice();
   ContourMesh& m = out.mesh;
   m.normals.resize(m.positions.size());
   m.vertex_material.resize(m.positions.size());
@@ -348,7 +383,7 @@ void RegionMesher::finish_vertices(ChunkMesh& out, ContourStats& stats) const {
 void RegionMesher::load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int low, int high) {
   cell_lo_ = own_lo - low;
   cell_hi_ = own_hi + high;
-  region_.load(world_, cell_lo_, cell_hi_ + 1, own_lo, own_hi);
+  region_.load(*world_, cell_lo_, cell_hi_ + 1, own_lo, own_hi);
 }
 
 // One material in the region: no vertex can sit on a material border.
@@ -372,12 +407,16 @@ void RegionMesher::mesh(const glm::ivec3& own_lo, const glm::ivec3& own_hi, Chun
   // neighbours' corners: one cell more; untangling untangle_reach cells more
   // on every side; relaxation one more cell per iteration, but only where
   // materials meet.
+  // The wide load (a superset) gives the same mesh on one material, so a
+  // mesher whose last region had several loads wide at once, saving the
+  // narrow load that would be thrown away on a landscape.
   const int untangle_margin = untangle_reach(config_);
-  load(own_lo, own_hi, 2 + untangle_margin, 1 + untangle_margin);
-  if (config_.relax_iterations > 0 && !single_material()) {
-    const int reach = vertex_reach(config_);
-    load(own_lo, own_hi, 1 + reach, reach);
-  }
+  const bool may_relax = config_.relax_iterations > 0;
+  const bool wide = may_relax && last_region_mixed_;
+  if (wide) load(own_lo, own_hi, 1 + vertex_reach(config_), vertex_reach(config_));
+  else load(own_lo, own_hi, 2 + untangle_margin, 1 + untangle_margin);
+  last_region_mixed_ = may_relax && !single_material();
+  if (last_region_mixed_ && !wide) load(own_lo, own_hi, 1 + vertex_reach(config_), vertex_reach(config_));
   stats.multi_crossing_edges += region_.multi_crossing_edges();
   stats.thin_edges += region_.thin_edges();
   if (region_.uniform()) return;

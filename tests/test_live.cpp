@@ -11,6 +11,7 @@
 #include <tbb/task_arena.h>
 #include <tbb/task_scheduler_observer.h>
 
+#include "ldc/build.h"
 #include "ldc/terrain.h"
 #include "live/live.h"
 #include "test_util.h"
@@ -80,6 +81,27 @@ TEST(LiveWorld, UpdateReportsTheChunkMeshesAnEditChangedAndMatchesAFreshBuild) {
   ASSERT_TRUE(idle.ok());
   EXPECT_TRUE(idle->meshes.empty());
   EXPECT_EQ(idle->dirty_chunks, 0u);
+}
+
+// Re-meshes keep a mesher per thread between updates (contour/mesh_patch.cpp);
+// it must not carry anything from one world or config to the next: a
+// landscape of several materials (relaxed, no untangle) and a sphere of one
+// material (untangled, relaxation off) edited in turn each match a fresh build.
+TEST(LiveWorld, MeshesOfTwoWorldsEditedInTurnMatchFreshBuilds) {
+  Result<LiveWorld> land = LiveWorld::create(small_landscape(), {.meshes = true});
+  World sphere_world = build_from_mesh(test::sphere_mesh({0, 0, 0}, 1.0, 4), {.cells = 64, .chunk_size = 16}).value();
+  LiveConfig sphere_config{.meshes = true, .contour = {.relax_iterations = 0, .untangle = true}};
+  Result<LiveWorld> sphere = LiveWorld::create(std::move(sphere_world), sphere_config);
+  ASSERT_TRUE(land.ok() && sphere.ok());
+  for (int round = 0; round < 2; ++round) {
+    const double x = 5.0 + 4.0 * round, z = ground_z(land->queries(), x, 8.0);
+    ASSERT_TRUE(land->apply(Brush::sphere({x, 8.0, z}, 1.2), EditOp::kSubtract).ok());
+    ASSERT_TRUE(land->update().ok());
+    EXPECT_TRUE(meshes_equal_fresh_build(*land)) << "landscape, round " << round;
+    ASSERT_TRUE(sphere->apply(Brush::sphere({0.0, 0.0, round ? -1.0 : 1.0}, 0.25), EditOp::kSubtract).ok());
+    ASSERT_TRUE(sphere->update().ok());
+    EXPECT_TRUE(meshes_equal_fresh_build(*sphere)) << "sphere, round " << round;
+  }
 }
 
 TEST(LiveWorld, UndoIsFannedOutLikeAnEdit) {

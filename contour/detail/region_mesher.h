@@ -14,7 +14,13 @@ namespace ldc::detail {
 
 class RegionMesher {
  public:
-  RegionMesher(const World& world, const ContourConfig& config) : world_(world), config_(config) {}
+  RegionMesher(const World& world, const ContourConfig& config) : world_(&world), config_(config) {}
+  // Meshes another world or config next, keeping the buffers (a mesher kept
+  // per thread then re-meshes small boxes without allocating).
+  void rebind(const World& world, const ContourConfig& config) {
+    world_ = &world;
+    config_ = config;
+  }
 
   // Cells [own_lo, own_hi) (by their lowest corner) and the edges whose lower
   // node lies there. Vertices of cells outside the box that these quads use
@@ -52,7 +58,7 @@ class RegionMesher {
 
   void load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int low, int high);
   bool single_material() const;
-  std::vector<uint8_t> cells_with_vertex() const;
+  void mark_cells_with_vertex();
   unsigned inside_corners(const glm::ivec3& cell) const;
   unsigned joined_faces(const glm::ivec3& cell, unsigned corners) const;
   const CellSheets& sheets_of(const glm::ivec3& cell) const;
@@ -60,13 +66,15 @@ class RegionMesher {
   uint8_t sheet_of(const glm::ivec3& cell, int axis, const glm::ivec3& node) const;
   CellPlanes planes_of(const glm::ivec3& cell, const CellSheets& sheets, int sheet) const;
   void place_vertices(const glm::ivec3& used_lo, const glm::ivec3& used_hi);
+  bool has_mixed_crossings(const glm::ivec3& cell) const;
   void add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes);
   void relax();
+  void find_border_neighbours();
   // Moves the vertices near self-intersecting triangles to their mass points
   // (see untangle.cpp); `decide_lo/hi` is the cell box whose vertices matter.
   void untangle(const glm::ivec3& decide_lo, const glm::ivec3& decide_hi);
   std::vector<uint8_t> tangled_cells(const glm::ivec3& test_lo, const glm::ivec3& test_hi) const;
-  glm::dvec3 relaxed_position(const CellVertex& v) const;
+  glm::dvec3 relaxed_position(size_t border_index) const;
   bool edge_quad(int axis, const glm::ivec3& node, Quad* quad) const;
   // The quads around one vertex: one per crossing edge of its sheet.
   int vertex_quads(const CellVertex& v, Quad* quads) const;
@@ -80,14 +88,20 @@ class RegionMesher {
             bool order_triangles);
   void finish_vertices(ChunkMesh& out, ContourStats& stats) const;
 
-  const World& world_;
+  const World* world_;
   ContourConfig config_;
   Region region_;
   glm::ivec3 cell_lo_{0}, cell_hi_{0};
+  std::vector<uint8_t> marked_;       // cells around a crossing edge
+  std::vector<int32_t> out_index_;     // emit: verts_ index -> output vertex
   std::vector<int32_t> cell_vertex_;   // index into verts_ of the cell's sheet 0 (its sheets follow), -1 without
   std::vector<uint16_t> cell_sheet_key_;  // of every cell with a vertex: inside corners | joined faces << 8
   std::vector<CellVertex> verts_;
   std::vector<uint32_t> border_;  // vertices on a material border
+  // Relaxation: border_[b]'s border neighbours are neighbours_[neighbour_begin_[b] .. neighbour_begin_[b + 1]).
+  std::vector<uint32_t> neighbour_begin_, neighbours_;
+  std::vector<glm::dvec3> relax_next_;
+  bool last_region_mixed_ = false;  // the last region meshed had several materials (a hint for load)
 };
 
 }  // namespace ldc::detail
