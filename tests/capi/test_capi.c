@@ -619,6 +619,17 @@ static ldc_world* small_slab(void) {
   return w;
 }
 
+/* One level of 8^3 voxels over `w`, checked. */
+static ldc_cascades* small_cascades(ldc_world* w) {
+  ldc_cascade_config cc;
+  ldc_cascade_config_default(&cc);
+  cc.levels = 1;
+  cc.resolution = 8;
+  ldc_cascades* cas = NULL;
+  CHECK_STATUS(ldc_cascades_create(w, &cc, &cas), LDC_OK);
+  return cas;
+}
+
 static int names_a_dead_handle(void) { return strstr(ldc_last_error(), "not a live") != NULL; }
 
 static void destroying_a_world_twice_is_refused(void) {
@@ -687,12 +698,7 @@ static void forged_and_wrong_type_handles_are_refused(void) {
   g_case = "forged_and_wrong_type_handles_are_refused";
   ldc_world* w = small_slab();
   if (!w) return;
-  ldc_cascade_config cc;
-  ldc_cascade_config_default(&cc);
-  cc.levels = 1;
-  cc.resolution = 8;
-  ldc_cascades* cas = NULL;
-  CHECK_STATUS(ldc_cascades_create(w, &cc, &cas), LDC_OK);
+  ldc_cascades* cas = small_cascades(w);
   ldc_world_info info;
   int on_the_stack = 0;
   ldc_world* forged[4] = {(ldc_world*)cas, (ldc_world*)(uintptr_t)0x1234, (ldc_world*)&on_the_stack,
@@ -714,18 +720,13 @@ static void destroying_cascades_twice_is_refused(void) {
   g_case = "destroying_cascades_twice_is_refused";
   ldc_world* w = small_slab();
   if (!w) return;
-  ldc_cascade_config cc;
-  ldc_cascade_config_default(&cc);
-  cc.levels = 1;
-  cc.resolution = 8;
-  ldc_cascades* cas = NULL;
-  CHECK_STATUS(ldc_cascades_create(w, &cc, &cas), LDC_OK);
+  ldc_cascades* cas = small_cascades(w);
   CHECK_STATUS(ldc_cascades_destroy(cas), LDC_OK);
   CHECK_STATUS(ldc_cascades_destroy(cas), LDC_INVALID_HANDLE);
   ldc_gbuffer_buffers g = {0};
   CHECK_STATUS(ldc_cascades_read_level(cas, 0, &g), LDC_INVALID_HANDLE);
   /* Cascades outliving their world: destroyed once, then refused. */
-  CHECK_STATUS(ldc_cascades_create(w, &cc, &cas), LDC_OK);
+  cas = small_cascades(w);
   CHECK_STATUS(ldc_world_destroy(w), LDC_OK);
   CHECK_STATUS(ldc_cascades_read_level(cas, 0, &g), LDC_OK);
   CHECK_STATUS(ldc_cascades_destroy(cas), LDC_OK);
@@ -766,12 +767,7 @@ static void a_null_buffer_with_a_capacity_is_refused(void) {
   ldc_path_info info;
   CHECK_STATUS(ldc_world_find_path(w, from, to, NULL, 4, &info), LDC_INVALID_ARGUMENT);
   CHECK(strstr(ldc_last_error(), "corners is NULL with capacity 4") != NULL);
-  ldc_cascade_config cc;
-  ldc_cascade_config_default(&cc);
-  cc.levels = 1;
-  cc.resolution = 8;
-  ldc_cascades* cas = NULL;
-  CHECK_STATUS(ldc_cascades_create(w, &cc, &cas), LDC_OK);
+  ldc_cascades* cas = small_cascades(w);
   ldc_gbuffer_buffers g = {0};
   g.texel_capacity = 7;
   CHECK_STATUS(ldc_cascades_read_level(cas, 0, &g), LDC_INVALID_ARGUMENT);
