@@ -49,17 +49,7 @@ struct Scene {
 
 using bench::add_box;
 
-World build(const TriangleMesh& m, double h) {
-  GridConfig g;
-  g.cell_size = h;
-  g.use_origin = true;
-  Result<World> w = build_from_mesh(m, g);
-  if (!w.ok()) {
-    std::fprintf(stderr, "build: %s\n", w.status().message().c_str());
-    std::exit(1);
-  }
-  return std::move(w).value();
-}
+World build(const TriangleMesh& m, double h) { return bench::build_on_origin(m, h); }
 
 MaterialTable cornell_materials() {
   MaterialTable t;

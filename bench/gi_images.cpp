@@ -57,12 +57,7 @@ World closed_room() {
   add_box(m, {-x, -y - t, -z}, {x, -y, z}, 0);
   add_box(m, {-x, y, -z}, {x, y + t, z}, 0);
   add_box(m, {-0.6, -0.2, -z}, {0.2, 0.6, -0.7}, 0);  // a block on the floor
-  GridConfig g;
-  g.cell_size = 0.1;
-  g.use_origin = true;
-  Result<World> w = build_from_mesh(m, g);
-  if (!w.ok()) std::exit(1);
-  return std::move(w).value();
+  return build_on_origin(m, 0.1);
 }
 
 MaterialTable room_materials(float emission) {

@@ -3,12 +3,15 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <utility>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "csg/csg.h"
+#include "ldc/build.h"
 #include "ldc/mesh.h"
 #include "ldc/terrain.h"
 
@@ -24,6 +27,20 @@ inline void add_box(TriangleMesh& m, glm::dvec3 lo, glm::dvec3 hi, uint16_t mat)
     m.triangles.emplace_back(b + f[0], b + f[2], b + f[3]);
     m.triangle_material.insert(m.triangle_material.end(), {mat, mat});
   }
+}
+
+// The mesh built onto a lattice of cell size h with its origin at 0 (box
+// faces on multiples of h stay on lattice planes); exits naming the error.
+inline World build_on_origin(const TriangleMesh& m, double h) {
+  GridConfig g;
+  g.cell_size = h;
+  g.use_origin = true;
+  Result<World> w = build_from_mesh(m, g);
+  if (!w.ok()) {
+    std::fprintf(stderr, "build: %s\n", w.status().message().c_str());
+    std::exit(1);
+  }
+  return std::move(w).value();
 }
 
 // scripts/default-tunnel.json's edits, as the main job applies them to the

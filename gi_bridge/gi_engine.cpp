@@ -275,11 +275,16 @@ void add_level(const PackedGBuffer& packed, int l, bool valid, GiLayout& out) {
 // that a wall of one voxel's thickness lying across two voxels still
 // closes the flood, while a tunnel a voxel wide stays open. Solid voxels
 // take the flag of any open air beside them.
+// Index of local voxel c within one level's N^3 block (x fastest).
+size_t level_local_index(int n, const glm::ivec3& c) {
+  return (size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x);
+}
+
 std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vector<uint8_t>* coarser,
                                  const GiLayout& out) {
   const int n = out.n;
   const VoxelBox box = cascades.level_box(l);
-  const auto local = [n](const glm::ivec3& c) { return (size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x); };
+  const auto local = [n](const glm::ivec3& c) { return level_local_index(n, c); };
   const auto inside = [n](const glm::ivec3& c) {
     return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n)));
   };
@@ -336,7 +341,7 @@ std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vec
 void restrict_to_finer(const Cascades& cascades, int l, const std::vector<uint8_t>& fine, std::vector<uint8_t>& coarse,
                        int n) {
   const glm::ivec3 fine_lo = cascades.level_box(l).lo, coarse_lo = cascades.level_box(l + 1).lo;
-  const auto local = [n](const glm::ivec3& c) { return (size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x); };
+  const auto local = [n](const glm::ivec3& c) { return level_local_index(n, c); };
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
       for (int x = 0; x < n; ++x) {

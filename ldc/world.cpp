@@ -5,7 +5,6 @@
 #include <bit>
 #include <cassert>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <limits>
 
@@ -206,13 +205,6 @@ Status check_world_config(const WorldConfig& config) {
   return detail::check_lattice_range(config, "world");
 }
 
-// A number as %g, for messages about magnitudes.
-std::string g_text(double x) {
-  char buffer[32];
-  std::snprintf(buffer, sizeof(buffer), "%g", x);
-  return buffer;
-}
-
 }  // namespace
 
 namespace detail {
@@ -230,21 +222,21 @@ Status check_lattice_range(const WorldConfig& config, std::string_view what) {
   const glm::dvec3 lo = config.lattice.origin + h * node_lo, hi = config.lattice.origin + h * node_hi;
   if (!is_finite(lo) || !is_finite(hi)) {
     return {ErrorCode::kInvalidArgument, prefix + "the lattice's box " + vec_text(lo) + " .. " + vec_text(hi) +
-                                             " is not finite (cell size " + g_text(h) + " m)"};
+                                             " is not finite (cell size " + number_g(h) + " m)"};
   }
   const glm::dvec3 reach = glm::max(glm::abs(lo), glm::abs(hi));
   const double magnitude = std::max(reach.x, std::max(reach.y, reach.z));
   if (magnitude > kMaxLatticeCoordinate) {
     return {ErrorCode::kTooLarge, prefix + "the lattice's box " + vec_text(lo) + " .. " + vec_text(hi) +
-                                      " reaches " + g_text(magnitude) + " m, past the limit of " +
-                                      g_text(kMaxLatticeCoordinate) + " m"};
+                                      " reaches " + number_g(magnitude) + " m, past the limit of " +
+                                      number_g(kMaxLatticeCoordinate) + " m"};
   }
   const double least = min_cell_size_at(magnitude);
   if (h < least) {
     return {ErrorCode::kInvalidArgument,
-            prefix + "cell size " + g_text(h) + " m is below the limit of " + g_text(least) +
-                " m for coordinates up to " + g_text(magnitude) + " m (" + g_text(kMinCellUlps) +
-                " units in the last place there, and at least " + g_text(kMinLatticeCellSize) +
+            prefix + "cell size " + number_g(h) + " m is below the limit of " + number_g(least) +
+                " m for coordinates up to " + number_g(magnitude) + " m (" + number_g(kMinCellUlps) +
+                " units in the last place there, and at least " + number_g(kMinLatticeCellSize) +
                 " m): doubles cannot place points within such a cell"};
   }
   return {};

@@ -11,6 +11,13 @@ namespace ldc::detail {
 
 inline bool is_finite(const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
+// A number with %g, for error messages.
+inline std::string number_g(double x) {
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%g", x);
+  return buffer;
+}
+
 // "(x, y, z)" with %g, for error messages.
 inline std::string vec_text(const glm::dvec3& v) {
   char buffer[96];
