@@ -318,7 +318,8 @@ void by_source(const Scene& s, int points, int paths) {
 
 // Timing only (`bench_gi 0 0 timing`): per scene and engine (default
 // config), the median and the minimum of 9 full updates after 3 passes, wall
-// and device time (single runs are noisy: lavapipe shares the cores).
+// and device time, and each stage's median device time (single runs are
+// noisy: lavapipe shares the cores).
 void timing(const Scene& s) {
   Result<Cascades> cas = bench_cascades(s, s.materials);
   if (!cas.ok()) return;
@@ -327,17 +328,21 @@ void timing(const Scene& s) {
     std::unique_ptr<GiEngine> engine = make_engine(cpu, {}, &device);
     if (!engine) continue;
     if (!engine->load(cas.value(), s.lights).ok() || !engine->update_all(3).ok()) return;
-    std::vector<double> wall, dev;
+    std::vector<double> wall, dev, cones, update, copy, precombine;
     for (int r = 0; r < 9; ++r) {
       Result<GiTimings> t = engine->update_all(1);
       if (!t.ok()) return;
+      const GiTimings::Stages& st = t.value().stage_device_seconds;
       wall.push_back(t.value().seconds);
       dev.push_back(t.value().device_seconds);
+      cones.push_back(st.cones);
+      update.push_back(st.update);
+      copy.push_back(st.copy);
+      precombine.push_back(st.precombine);
     }
-    std::sort(wall.begin(), wall.end());
-    std::sort(dev.begin(), dev.end());
-    std::printf("| %s | %s | %.4f | %.4f | %.4f | %.4f |\n", s.name.c_str(), device.c_str(), wall[4], wall[0], dev[4],
-                dev[0]);
+    for (std::vector<double>* v : {&wall, &dev, &cones, &update, &copy, &precombine}) std::sort(v->begin(), v->end());
+    std::printf("| %s | %s | %.4f | %.4f | %.4f | %.4f | %.3f | %.3f | %.3f | %.3f |\n", s.name.c_str(), device.c_str(),
+                wall[4], wall[0], dev[4], dev[0], 1e3 * cones[4], 1e3 * update[4], 1e3 * copy[4], 1e3 * precombine[4]);
   }
 }
 
@@ -348,7 +353,8 @@ int main(int argc, char** argv) {
   const int paths = argc > 2 ? std::atoi(argv[2]) : 512;
   std::printf("# bench_gi: cone-traced GI (Vulkan engine rows name their device; llvmpipe = Mesa's lavapipe on the CPU) vs path-traced reference\n");
   if (argc > 3 && std::string(argv[3]) == "timing") {
-    std::printf("| scene | engine | full update s (median of 9) | min | device s (median) | min |\n|---|---|---|---|---|---|\n");
+    std::printf("| scene | engine | full update s (median of 9) | min | device s (median) | min | cones ms (median) | update "
+                "ms | copy ms | precombine ms |\n|---|---|---|---|---|---|---|---|---|---|\n");
     timing(cornell());
     timing(landscape());
     timing(shared_mesh());

@@ -185,6 +185,14 @@ struct GiTimings {
   // update's command buffer (Vulkan), the kernels' wall time (CPU engine);
   // < 0 where the device's queue has no timestamps.
   double device_seconds = -1.0;
+  // device_seconds split by stage, in the order they run: the cones (each
+  // surface voxel's 16 cone traces), the light update, the copy of the new
+  // light over the old, the precombine of the next pass's cone inputs.
+  // GPU timestamps between the stages (Vulkan), each stage's wall time (CPU
+  // engine); all < 0 where device_seconds is.
+  struct Stages {
+    double cones = -1.0, update = -1.0, copy = -1.0, precombine = -1.0;
+  } stage_device_seconds;
 };
 
 // Per-face radiance read back: for each surface voxel (level, global voxel

@@ -99,15 +99,19 @@ class CpuGi final : public GiEngineBase {
   }
 
   Status run_steps(const std::vector<GiStep>& steps) override {
-    const auto t0 = std::chrono::steady_clock::now();
+    using Clock = std::chrono::steady_clock;
+    const auto t0 = Clock::now();
+    for (double& k : last_kernel_seconds_) k = 0.0;
     for (const GiStep& step : steps) {
+      const auto start = Clock::now();
       if (step.kernel == GiKernel::kCommit) {
         commit(step.first, step.count);
       } else {
         run_kernel(step);
       }
+      last_kernel_seconds_[int(step.kernel) - 1] += std::chrono::duration<double>(Clock::now() - start).count();
     }
-    last_device_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    last_device_seconds_ = std::chrono::duration<double>(Clock::now() - t0).count();
     return {};
   }
 

@@ -447,8 +447,18 @@ Result<GiTimings> GiEngineBase::update_levels(const std::vector<int>& levels) {
   t.levels_updated = int(levels.size());
   t.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   t.device_seconds = last_device_seconds_;
+  const auto kernel = [&](GiKernel k) { return last_kernel_seconds_[int(k) - 1]; };
+  t.stage_device_seconds = {kernel(GiKernel::kCones), kernel(GiKernel::kUpdate), kernel(GiKernel::kCommit),
+                            kernel(GiKernel::kPrecombine)};
   return t;
 }
+
+namespace {
+
+// a + b, or -1 where either was not measured.
+double add_measured(double a, double b) { return a < 0 || b < 0 ? -1.0 : a + b; }
+
+}  // namespace
 
 Result<GiTimings> GiEngineBase::update_level(int level) { return update_levels({level}); }
 
@@ -462,8 +472,17 @@ Result<GiTimings> GiEngineBase::update_all(int passes) {
     sum.levels_updated += t.value().levels_updated;
     sum.surface_voxels += t.value().surface_voxels;
     sum.seconds += t.value().seconds;
-    const double dev = t.value().device_seconds;
-    sum.device_seconds = p == 0 ? dev : (dev < 0 || sum.device_seconds < 0 ? -1.0 : sum.device_seconds + dev);
+    const GiTimings& one = t.value();
+    if (p == 0) {
+      sum.device_seconds = one.device_seconds;
+      sum.stage_device_seconds = one.stage_device_seconds;
+      continue;
+    }
+    sum.device_seconds = add_measured(sum.device_seconds, one.device_seconds);
+    GiTimings::Stages& s = sum.stage_device_seconds;
+    const GiTimings::Stages& o = one.stage_device_seconds;
+    s = {add_measured(s.cones, o.cones), add_measured(s.update, o.update), add_measured(s.copy, o.copy),
+         add_measured(s.precombine, o.precombine)};
   }
   return sum;
 }

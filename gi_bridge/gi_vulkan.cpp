@@ -5,8 +5,8 @@
 // its BAR heap, falling back to host memory when that is full). A lighting
 // update is one command buffer (the levels' cones, their updates, the copies
 // of the new light over the old, the precombines, with a barrier between
-// kinds), one submit waited on with a fence; two GPU timestamps around its
-// work give GiTimings::device_seconds.
+// kinds), one submit waited on with a fence; GPU timestamps around its work
+// give GiTimings::device_seconds, and between the kinds the time per kernel.
 #include <cstring>
 #include <vector>
 
@@ -37,6 +37,10 @@ constexpr int kBindings = 14;
 constexpr int kKernels = 5;  // GiKernel kAlpha .. kCones
 constexpr int kGroup = 64;         // local_size_x
 constexpr int kMaxGroups = 65535;  // per dispatch (the guaranteed minimum)
+// Timestamps per submit: one before the work and one after each run of steps
+// of one kind (a full update has 4 such runs); a submit with more runs
+// than that times only the whole.
+constexpr uint32_t kMaxTimestamps = 64;
 
 Status vk_error(const char* what, VkResult r) {
   return Status(ErrorCode::kIoError, std::string("vulkan: ") + what + " failed (VkResult " + std::to_string(int(r)) + ")");
@@ -74,7 +78,10 @@ class VulkanGi final : public GiEngineBase {
   Status make_pipelines();
   // The chosen queue family's timestampValidBits and the device's timestampPeriod.
   Status make_timestamps(uint32_t bits, float period_ns);
-  double device_seconds() const;
+  void write_timestamp(uint32_t index);
+  // Reads the last submit's timestamps into last_device_seconds_ and, for
+  // `runs` (the kernel of each run of steps), last_kernel_seconds_.
+  void read_timestamps(const std::vector<GiKernel>& runs);
   void destroy();
 
   VkInstance instance_ = VK_NULL_HANDLE;
@@ -90,8 +97,8 @@ class VulkanGi final : public GiEngineBase {
   VkCommandPool command_pool_ = VK_NULL_HANDLE;
   VkCommandBuffer cmd_ = VK_NULL_HANDLE;
   VkFence fence_ = VK_NULL_HANDLE;
-  // Two timestamps around each submit's work; none where the queue family
-  // has no timestamps (timestampValidBits 0).
+  // Timestamps in each submit's work; none where the queue family has no
+  // timestamps (timestampValidBits 0).
   VkQueryPool timestamps_ = VK_NULL_HANDLE;
   uint64_t timestamp_mask_ = 0;
   double timestamp_period_ns_ = 1.0;
@@ -178,21 +185,48 @@ Status VulkanGi::make_timestamps(uint32_t bits, float period_ns) {
   timestamp_period_ns_ = double(period_ns);
   VkQueryPoolCreateInfo qpi{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
   qpi.queryType = VK_QUERY_TYPE_TIMESTAMP;
-  qpi.queryCount = 2;
+  qpi.queryCount = kMaxTimestamps;
   if (VkResult r = vkCreateQueryPool(device_, &qpi, nullptr, &timestamps_); r != VK_SUCCESS)
     return vk_error("vkCreateQueryPool", r);
   return {};
 }
 
-// Seconds between the two timestamps of the last submit; -1 without them.
-double VulkanGi::device_seconds() const {
-  if (timestamps_ == VK_NULL_HANDLE) return -1.0;
-  uint64_t t[2] = {0, 0};
-  if (vkGetQueryPoolResults(device_, timestamps_, 0, 2, sizeof(t), t, sizeof(uint64_t),
+// The kernel of each run of (non-empty) steps of one kind, in order.
+std::vector<GiKernel> kernel_runs(const std::vector<GiStep>& steps) {
+  std::vector<GiKernel> runs;
+  for (const GiStep& step : steps) {
+    if (step.count > 0 && (runs.empty() || runs.back() != step.kernel)) runs.push_back(step.kernel);
+  }
+  return runs;
+}
+
+// Whether a submit of these runs gets a timestamp after each run (else one
+// at index 1 after all the work).
+bool timed_per_run(const std::vector<GiKernel>& runs) { return !runs.empty() && runs.size() < kMaxTimestamps; }
+
+void VulkanGi::write_timestamp(uint32_t index) {
+  if (timestamps_ != VK_NULL_HANDLE && index < kMaxTimestamps)
+    vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, index);
+}
+
+void VulkanGi::read_timestamps(const std::vector<GiKernel>& runs) {
+  last_device_seconds_ = -1.0;
+  for (double& k : last_kernel_seconds_) k = -1.0;
+  if (timestamps_ == VK_NULL_HANDLE) return;
+  const bool per_run = timed_per_run(runs);
+  const uint32_t count = per_run ? uint32_t(runs.size() + 1) : 2;
+  std::vector<uint64_t> t(count, 0);
+  if (vkGetQueryPoolResults(device_, timestamps_, 0, count, t.size() * sizeof(uint64_t), t.data(), sizeof(uint64_t),
                             VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT) != VK_SUCCESS)
-    return -1.0;
-  const uint64_t ticks = ((t[1] & timestamp_mask_) - (t[0] & timestamp_mask_)) & timestamp_mask_;
-  return double(ticks) * timestamp_period_ns_ * 1e-9;
+    return;
+  const auto seconds = [&](uint32_t from, uint32_t to) {
+    const uint64_t ticks = ((t[to] & timestamp_mask_) - (t[from] & timestamp_mask_)) & timestamp_mask_;
+    return double(ticks) * timestamp_period_ns_ * 1e-9;
+  };
+  last_device_seconds_ = seconds(0, count - 1);
+  if (!per_run) return;
+  for (double& k : last_kernel_seconds_) k = 0.0;
+  for (uint32_t r = 0; r < runs.size(); ++r) last_kernel_seconds_[int(runs[r]) - 1] += seconds(r, r + 1);
 }
 
 Status VulkanGi::make_pipelines() {
@@ -378,23 +412,30 @@ Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
   begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
   vkBeginCommandBuffer(cmd_, &begin);
   if (timestamps_ != VK_NULL_HANDLE) {
-    vkCmdResetQueryPool(cmd_, timestamps_, 0, 2);
+    vkCmdResetQueryPool(cmd_, timestamps_, 0, kMaxTimestamps);
     vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, timestamps_, 0);
   }
   vkCmdBindDescriptorSets(cmd_, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline_layout_, 0, 1, &set_, 0, nullptr);
   const VkPipelineStageFlags work = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT;
+  const std::vector<GiKernel> runs = kernel_runs(steps);
+  const bool per_run = timed_per_run(runs);
+  GiKernel last = GiKernel::kCommit;
+  uint32_t run = 0;
   for (size_t i = 0; i < steps.size(); ++i) {
     if (steps[i].count <= 0) continue;
     // Steps of one kind touch disjoint items; a step of another kind waits
     // for everything before it (reads after writes, and the copies
     // overwrite light the updates read).
-    if (i > 0 && steps[i].kernel != steps[i - 1].kernel) {
+    if (run > 0 && steps[i].kernel != last) {
+      if (per_run) write_timestamp(run);
       VkMemoryBarrier between{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
       between.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
       between.dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_READ_BIT |
                               VK_ACCESS_TRANSFER_WRITE_BIT;
       vkCmdPipelineBarrier(cmd_, work, work, 0, 1, &between, 0, nullptr, 0, nullptr);
     }
+    if (run == 0 || steps[i].kernel != last) ++run;
+    last = steps[i].kernel;
     record(steps[i]);
   }
   // The host reads (memcpy) what the steps wrote: make it visible.
@@ -402,7 +443,7 @@ Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
   to_host.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT;
   to_host.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
   vkCmdPipelineBarrier(cmd_, work, VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &to_host, 0, nullptr, 0, nullptr);
-  if (timestamps_ != VK_NULL_HANDLE) vkCmdWriteTimestamp(cmd_, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, timestamps_, 1);
+  write_timestamp(per_run ? uint32_t(runs.size()) : 1);
   vkEndCommandBuffer(cmd_);
   VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
   submit.commandBufferCount = 1;
@@ -412,7 +453,7 @@ Status VulkanGi::run_steps(const std::vector<GiStep>& steps) {
     return vk_error("vkWaitForFences", r);
   vkResetFences(device_, 1, &fence_);
   vkResetCommandBuffer(cmd_, 0);
-  last_device_seconds_ = device_seconds();
+  read_timestamps(runs);
   return {};
 }
 

@@ -441,7 +441,7 @@ TEST(GiCpu, NearFarSplitConesKeepWallsClosedAndTheSkyOpen) {
 }
 
 // The CPU engine's device time is its kernels' wall time: positive, within
-// the update's wall time, summed over update_all's passes.
+// the update's wall time, split into stages, summed over update_all's passes.
 TEST(GiCpu, DeviceTimeIsTheKernelsTime) {
   const World world = test::build_boxes(test::closed_room(2));
   const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
@@ -452,6 +452,7 @@ TEST(GiCpu, DeviceTimeIsTheKernelsTime) {
     ASSERT_TRUE(t.ok());
     EXPECT_GT(t.value().device_seconds, 0.0) << passes << " passes";
     EXPECT_LE(t.value().device_seconds, t.value().seconds) << passes << " passes";
+    test::expect_stages_within_device_time(t.value(), passes == 1 ? "1 pass" : "3 passes");
   }
 }
 

@@ -88,7 +88,8 @@ class GiEngineBase : public GiEngine {
   virtual Status upload_lights(const GiLayout& layout) = 0;
   // Runs the steps in order, each seeing what the ones before wrote (the
   // Vulkan engine records them in one command buffer: one submit), and
-  // sets last_device_seconds_ (GiTimings::device_seconds).
+  // sets last_device_seconds_ (GiTimings::device_seconds) and
+  // last_kernel_seconds_.
   virtual Status run_steps(const std::vector<GiStep>& steps) = 0;
   Status run(GiKernel kernel, int first, int count, int level) { return run_steps({{kernel, first, count, level}}); }
   virtual Status set_queries(const std::vector<glm::vec4>& qin) = 0;
@@ -102,6 +103,9 @@ class GiEngineBase : public GiEngine {
   bool loaded_ = false;
   uint64_t frame_ = 0;
   double last_device_seconds_ = -1.0;
+  // The last run_steps' device time per kernel, [int(GiKernel) - 1]; -1
+  // where it was not measured.
+  double last_kernel_seconds_[6] = {-1.0, -1.0, -1.0, -1.0, -1.0, -1.0};
 };
 
 }  // namespace ldc::detail

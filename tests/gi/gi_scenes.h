@@ -121,4 +121,16 @@ inline World build_ball_over_ground(const glm::dvec3& centre, double r, double h
   return std::move(w).value();
 }
 
+// A full update's stage times: each measured, the cones and updates > 0,
+// and together at most the device time (Vulkan: their timestamps tile it;
+// CPU: the loop between the kernels is left out). `where` names the case.
+inline void expect_stages_within_device_time(const GiTimings& t, const char* where) {
+  const GiTimings::Stages& s = t.stage_device_seconds;
+  EXPECT_GT(s.cones, 0.0) << where;
+  EXPECT_GT(s.update, 0.0) << where;
+  EXPECT_GE(s.copy, 0.0) << where;
+  EXPECT_GE(s.precombine, 0.0) << where;
+  EXPECT_LE(s.cones + s.update + s.copy + s.precombine, t.device_seconds * (1.0 + 1e-9)) << where;
+}
+
 }  // namespace ldc::test

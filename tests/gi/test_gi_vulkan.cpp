@@ -237,7 +237,8 @@ TEST(GiVulkan, SkyOnlyOpenPlaneGetsTheAnalyticIrradiance) {
 
 // GPU timestamps around an update's work: positive and within the wall
 // time from recording to fence (a device whose queue has no timestamps
-// reports -1, and says so here); update_all sums its passes.
+// reports -1, and says so here), split into stages that add up to it;
+// update_all sums its passes.
 TEST(GiVulkan, DeviceTimeIsMeasuredWithinTheWallTime) {
   auto gpu = vulkan_or_skip();
   if (!gpu) GTEST_SKIP() << "no Vulkan device";
@@ -248,10 +249,14 @@ TEST(GiVulkan, DeviceTimeIsMeasuredWithinTheWallTime) {
   if (one.value().device_seconds < 0) GTEST_SKIP() << "the device's queue has no timestamps";
   EXPECT_GT(one.value().device_seconds, 0.0);
   EXPECT_LE(one.value().device_seconds, 1.05 * one.value().seconds + 1e-4);
+  test::expect_stages_within_device_time(one.value(), "1 pass");
+  const GiTimings::Stages& s = one.value().stage_device_seconds;
+  EXPECT_NEAR(s.cones + s.update + s.copy + s.precombine, one.value().device_seconds, 1e-9) << "timestamps tile the work";
   Result<GiTimings> two = gpu->update_all(2);
   ASSERT_TRUE(two.ok());
   EXPECT_GT(two.value().device_seconds, 0.0);
   EXPECT_LE(two.value().device_seconds, 1.05 * two.value().seconds + 1e-4);
+  test::expect_stages_within_device_time(two.value(), "2 passes");
   EXPECT_EQ(two.value().levels_updated, 2 * one.value().levels_updated);
 }
 
