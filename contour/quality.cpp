@@ -388,7 +388,35 @@ std::vector<TrianglePair> self_intersecting_pairs(const ContourMesh& mesh, const
 
 }  // namespace detail
 
+namespace {
+
+// A power of two that brings the mesh's largest coordinate near 1 when it is
+// beyond 1e60 or below 1e-60, else 1: there the predicates' products (a
+// coordinate cubed) and a squared cross product (an edge length to the
+// fourth) would overflow or underflow. Exact, so every predicate and angle
+// sees the same triangles.
+double extreme_scale(const ContourMesh& mesh) {
+  double largest = 0.0;
+  for (const glm::dvec3& p : mesh.positions) {
+    const glm::dvec3 a = glm::abs(p);
+    if (std::isfinite(a.x + a.y + a.z)) largest = std::max({largest, a.x, a.y, a.z});
+  }
+  if (largest == 0.0 || (largest > 1e-60 && largest < 1e60)) return 1.0;
+  return std::ldexp(1.0, -std::ilogb(largest));
+}
+
+}  // namespace
+
 MeshQuality mesh_quality(const ContourMesh& mesh, const QualityOptions& options) {
+  if (const double scale = extreme_scale(mesh); scale != 1.0) {
+    ContourMesh scaled = mesh;
+    for (glm::dvec3& p : scaled.positions) p *= scale;
+    MeshQuality quality = mesh_quality(scaled, options);
+    // Back to world units: beyond a double's range (a mesh at 1e200 m) inf, never NaN.
+    quality.area = quality.area / scale / scale;
+    quality.volume = quality.volume / scale / scale / scale;
+    return quality;
+  }
   MeshQuality quality;
   quality.triangles = mesh.triangle_count();
   quality.vertices = mesh.vertex_count();

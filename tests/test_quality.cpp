@@ -74,6 +74,32 @@ TEST(Quality, AZeroAreaTriangleIsNamed) {
   EXPECT_EQ(quality_failures(q), "2 self-intersecting triangle pairs, 1 degenerate triangle");
 }
 
+// Area and volume at scales where an edge length to the fourth overflows
+// (1e100 m) or underflows (1e-100 m): the right figures, the same angles
+// and counts as the unit cube; past a double's range (1e200 m: area 6e400)
+// inf, never NaN.
+TEST(Quality, AreaAndVolumeHoldAtExtremeScales) {
+  for (const double side : {1e100, 1e-100, 1e150}) {
+    ContourMesh m;
+    test::add_box(m, glm::dvec3(side), glm::dvec3(2.0 * side));
+    const MeshQuality q = mesh_quality(m);
+    EXPECT_NEAR(q.area / (6.0 * side * side), 1.0, 1e-12) << side;
+    if (side < 1e150) {
+      EXPECT_NEAR(q.volume / (side * side * side), 1.0, 1e-12) << side;
+    }
+    EXPECT_EQ(q.degenerate_triangles, 0u) << side;
+    EXPECT_NEAR(q.min_angle_deg, 45.0, 1e-9) << side;
+    EXPECT_TRUE(q.closed()) << side << ": " << quality_failures(q);
+  }
+  ContourMesh huge;
+  test::add_box(huge, glm::dvec3(1e200), glm::dvec3(2e200));
+  const MeshQuality q = mesh_quality(huge);
+  EXPECT_TRUE(std::isinf(q.area));
+  EXPECT_TRUE(std::isinf(q.volume));
+  EXPECT_NEAR(q.min_angle_deg, 45.0, 1e-9);
+  EXPECT_EQ(q.degenerate_triangles, 0u);
+}
+
 TEST(Quality, BowTieIsWatertightButNotClosed) {
   // Two closed cubes sharing one corner: every edge paired, one vertex with two fans.
   ContourMesh m;

@@ -125,7 +125,8 @@ void print_report(const nlohmann::json& j) {
     std::printf("  untangled: %zu self-intersecting pairs -> %zu, %zu vertices moved\n",
                 u["pairs_before"].get<size_t>(), u["pairs_after"].get<size_t>(), u["vertices_moved"].get<size_t>());
   }
-  std::printf("  min angle %.1f deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
+  // %.3g: a sliver of 0.004 degrees (not degenerate) must not read "0.0".
+  std::printf("  min angle %.3g deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
   for (const auto& b : q["min_angle_histogram_10deg"]) std::printf(" %zu", b.get<size_t>());
   std::printf("\n  area %.6g, volume %.6g\n", q["area"].get<double>(), q["volume"].get<double>());
   print_seconds(j["seconds"]);
