@@ -153,6 +153,15 @@ class ImplicitSolid {
 Result<World> build_from_implicit(const ImplicitSolid& solid, const GridConfig& grid,
                                   Context* ctx = nullptr, BuildReport* report = nullptr);
 
+// One chunk of the world build_from_implicit makes, built alone (the chunk
+// sources of ldc/store.h build a large world a chunk at a time). Given the
+// lattice of that build and `bounds` = solid.bounds(), the result equals the
+// whole build's chunk bit for bit (same families; uniform families where the
+// build stores a flag). Chunks outside the bounds come out uniform outside.
+// Thread safety: as build_from_implicit (the solid is only read).
+Chunk build_implicit_chunk(const ImplicitSolid& solid, const WorldBox& bounds, const Lattice& lattice,
+                           int chunk_size, const glm::ivec3& chunk);
+
 // --- Analytic primitives ------------------------------------------------------
 
 struct Primitive {

@@ -1,5 +1,6 @@
 // Implicit solid -> LDC: node signs sampled per chunk, one point per sign-changing cell edge.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <new>
@@ -171,7 +172,34 @@ RayFamily implicit_family(const ImplicitSolid& solid, const Lattice& lat, const 
   return wr.finish();
 }
 
+// Fills the three families of the chunk at node0 (uniform ones when the
+// chunk is all outside or all inside): the one chunk build that both
+// build_from_implicit and build_implicit_chunk run, so they agree bit for bit.
+void build_chunk_families(const ImplicitSolid& solid, const WorldBox& bounds, const Lattice& lat,
+                          const glm::ivec3& node0, int c, NodeSamples& samples,
+                          ImplicitCounts& counts, std::array<RayFamily, 3>& families) {
+  WorldBox box{lat.node_position(node0), lat.node_position(node0 + glm::ivec3(c))};
+  ImplicitSolid::BoxClass cls = solid.classify(box);
+  int uniform = cls == ImplicitSolid::BoxClass::kOutside  ? 0
+                : cls == ImplicitSolid::BoxClass::kInside ? 1
+                                                          : sample_chunk(solid, bounds, lat, node0, c, samples);
+  if (uniform >= 0) {
+    for (RayFamily& f : families) f = RayFamily::uniform(uniform == 1);
+    return;
+  }
+  for (int a = 0; a < 3; ++a) families[a] = implicit_family(solid, lat, node0, a, c, samples, counts);
+}
+
 }  // namespace
+
+Chunk build_implicit_chunk(const ImplicitSolid& solid, const WorldBox& bounds, const Lattice& lattice,
+                           int chunk_size, const glm::ivec3& chunk) {
+  NodeSamples samples;
+  ImplicitCounts counts;
+  Chunk out;
+  build_chunk_families(solid, bounds, lattice, chunk * chunk_size, chunk_size, samples, counts, out.axis);
+  return out;
+}
 
 Result<World> build_from_implicit(const ImplicitSolid& solid, const GridConfig& grid, Context* ctx,
                                   BuildReport* report_out) {
@@ -198,19 +226,8 @@ Result<World> build_from_implicit(const ImplicitSolid& solid, const GridConfig& 
     tbb::parallel_for(size_t{0}, slots, [&](size_t slot) {
       if (progress.cancelled()) return;
       glm::ivec3 node0 = slot_chunk(world, slot) * c;
-      WorldBox box{lat.node_position(node0), lat.node_position(node0 + glm::ivec3(c))};
-      ImplicitSolid::BoxClass cls = solid.classify(box);
-      int uniform = cls == ImplicitSolid::BoxClass::kOutside  ? 0
-                    : cls == ImplicitSolid::BoxClass::kInside ? 1
-                                                              : sample_chunk(solid, b, lat, node0, c, samples.local());
-      if (uniform >= 0) {
-        assembly.set_uniform(slot, uniform == 1);
-      } else {
-        for (int a = 0; a < 3; ++a) {
-          assembly.families(slot)[a] =
-              implicit_family(solid, lat, node0, a, c, samples.local(), counts.local());
-        }
-      }
+      build_chunk_families(solid, b, lat, node0, c, samples.local(), counts.local(),
+                           assembly.families(slot));
       progress.step();
     });
     if (progress.cancelled()) return cancelled_status("implicit");

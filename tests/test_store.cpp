@@ -1,0 +1,471 @@
+// Chunk sources and the paged world (ldc/store.h): generated chunks equal the
+// whole build, windows equal the same box of it under any budget, edits put
+// back survive eviction, and a kilometre-wide source costs its window only.
+#include <gtest/gtest.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <tbb/global_control.h>
+
+#include "csg/csg.h"
+#include "ldc/store.h"
+#include "ldc/terrain.h"
+#include "test_util.h"
+
+namespace ldc {
+namespace {
+
+constexpr double kH = 0.25;
+constexpr int kC = 16;
+
+TerrainConfig small_terrain() {
+  TerrainConfig t;
+  t.size_x = 16.0;
+  t.size_y = 16.0;
+  return t;
+}
+
+// The whole build every test compares with, built once.
+const World& whole_world() {
+  static const World w = build_terrain(small_terrain(), kH, kC).value();
+  return w;
+}
+
+std::shared_ptr<const ImplicitSource> small_source() {
+  return make_terrain_source(small_terrain(), kH, kC).value();
+}
+
+::testing::AssertionResult same_family(const RayFamily& a, const RayFamily& b, int c) {
+  if (a.is_uniform() != b.is_uniform()) return ::testing::AssertionFailure() << "uniformity differs";
+  if (a.is_uniform()) {
+    if (a.uniform_inside() == b.uniform_inside()) return ::testing::AssertionSuccess();
+    return ::testing::AssertionFailure() << "uniform state differs";
+  }
+  for (int r = 0; r < c * c; ++r) {
+    const auto pa = a.points(r), pb = b.points(r);
+    if (a.starts_inside(r) != b.starts_inside(r)) return ::testing::AssertionFailure() << "ray " << r << " start";
+    if (pa.size() != pb.size() || (!pa.empty() && std::memcmp(pa.data(), pb.data(), pa.size_bytes()) != 0)) {
+      return ::testing::AssertionFailure() << "ray " << r << " points differ";
+    }
+  }
+  return ::testing::AssertionSuccess();
+}
+
+::testing::AssertionResult same_chunk(ChunkKind ka, const Chunk* a, ChunkKind kb, const Chunk* b, int c) {
+  if (ka != kb) return ::testing::AssertionFailure() << chunk_kind_name(ka) << " vs " << chunk_kind_name(kb);
+  if (ka != ChunkKind::kMixed) return ::testing::AssertionSuccess();
+  for (int ax = 0; ax < 3; ++ax) {
+    auto r = same_family(a->axis[ax], b->axis[ax], c);
+    if (!r) return r << " on axis " << ax;
+  }
+  return ::testing::AssertionSuccess();
+}
+
+// Every chunk of `part` equals the same chunk of `whole`.
+::testing::AssertionResult same_chunks_as(const World& part, const World& whole) {
+  bool ok = true;
+  std::string first;
+  part.for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk* data) {
+    auto r = same_chunk(kind, data, whole.chunk_kind(ch), whole.chunk(ch), part.chunk_size());
+    if (!r && ok) {
+      ok = false;
+      first = "chunk (" + std::to_string(ch.x) + ", " + std::to_string(ch.y) + ", " + std::to_string(ch.z) +
+              "): " + r.message();
+    }
+  });
+  return ok ? ::testing::AssertionSuccess() : ::testing::AssertionFailure() << first;
+}
+
+// Bytes the cache counts for a window's chunks.
+size_t window_bytes(const World& w) {
+  size_t bytes = 0;
+  w.for_each_chunk([&](const glm::ivec3&, ChunkKind, const Chunk* data) {
+    bytes += kPagingEntryBytes + (data ? data->memory_bytes() : 0);
+  });
+  return bytes;
+}
+
+glm::ivec3 box_end(const SourceBox& b) { return b.chunk_origin + b.chunk_dims; }
+
+TEST(Store, GeneratedChunksEqualTheWholeBuild) {
+  const World& whole = whole_world();
+  auto source = small_source();
+  const SourceLayout& lay = source->layout();
+  EXPECT_EQ(lay.box.chunk_origin, whole.chunk_origin());
+  EXPECT_EQ(lay.box.chunk_dims, whole.chunk_dims());
+  EXPECT_EQ(lay.lattice.origin, whole.lattice().origin);
+  EXPECT_EQ(lay.lattice.cell_size, whole.lattice().cell_size);
+  size_t mixed = 0, compared = 0;
+  whole.for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk* data) {
+    Result<StoredChunk> got = source->read(ch);
+    ASSERT_TRUE(got.ok()) << got.status().to_string();
+    EXPECT_EQ((got->data != nullptr), (got->kind == ChunkKind::kMixed));
+    EXPECT_TRUE(same_chunk(got->kind, got->data.get(), kind, data, kC)) << ch.x << " " << ch.y << " " << ch.z;
+    mixed += kind == ChunkKind::kMixed;
+    ++compared;
+  });
+  EXPECT_GT(mixed, 10u);
+  EXPECT_EQ(compared, size_t(lay.box.slots()));
+  // Outside the box: empty, as the whole world answers.
+  Result<StoredChunk> outside = source->read(box_end(lay.box) + glm::ivec3(3));
+  ASSERT_TRUE(outside.ok());
+  EXPECT_EQ(outside->kind, ChunkKind::kEmpty);
+}
+
+TEST(Store, WindowsEqualTheWholeBuildAndValidate) {
+  const World& whole = whole_world();
+  PagedWorld paged(small_source());
+  const SourceBox box = paged.layout().box;
+  // A window asked larger than the box is clipped to it: the whole world again.
+  Result<World> full = paged.window(box.chunk_origin - 5, box_end(box) + 5);
+  ASSERT_TRUE(full.ok()) << full.status().to_string();
+  EXPECT_EQ(full->chunk_dims(), whole.chunk_dims());
+  EXPECT_TRUE(same_chunks_as(*full, whole));
+  EXPECT_TRUE(test::is_valid(*full));
+  // A window inside the box: its chunks are the whole build's; validate()
+  // finds only the cuts at its faces (rays inside where the box cuts the ground).
+  const glm::ivec3 lo = box.chunk_origin + glm::ivec3(1, 1, 0), hi = box_end(box) - glm::ivec3(1, 1, 0);
+  Result<World> part = paged.window(lo, hi);
+  ASSERT_TRUE(part.ok());
+  EXPECT_EQ(part->chunk_origin(), lo);
+  EXPECT_TRUE(same_chunks_as(*part, whole));
+  ValidateOptions opts;
+  opts.max_messages = 100000;
+  const ValidationReport report = validate(*part, opts);
+  for (const std::string& m : report.messages) {
+    EXPECT_TRUE(m.find("world box face") != std::string::npos ||
+                m.find("boundary to the next chunk") != std::string::npos)
+        << m;
+  }
+  // Windows share the cached chunks: no copy.
+  Result<World> again = paged.window(lo, hi);
+  ASSERT_TRUE(again.ok());
+  const glm::ivec3 mid = (lo + hi) / 2;
+  for (int z = lo.z; z < hi.z; ++z) {
+    const glm::ivec3 ch(mid.x, mid.y, z);
+    EXPECT_EQ(again->chunk(ch), part->chunk(ch));
+  }
+  EXPECT_GT(paged.stats().hits, 0u);
+}
+
+TEST(Store, PagedQueriesEqualUnpagedOnes) {
+  const World& whole = whole_world();
+  PagedWorld paged(small_source());
+  const SourceBox box = paged.layout().box;
+  // Partial in x and y, whole in z: Z rays of the window are whole rays.
+  const glm::ivec3 lo = box.chunk_origin + glm::ivec3(1, 1, 0);
+  const glm::ivec3 hi = box_end(box) - glm::ivec3(1, 1, 0);
+  Result<World> win = paged.window(lo, hi);
+  ASSERT_TRUE(win.ok());
+  std::mt19937 rng(7);
+  auto uniform = [&](double a, double b) { return a + (b - a) * (double(rng()) / 4294967296.0); };
+  const glm::dvec3 n0 = glm::dvec3(win->node_min()) + 1.0, n1 = glm::dvec3(win->node_end()) - 1.0;
+  int inside = 0;
+  for (int i = 0; i < 400; ++i) {
+    const glm::dvec3 l(uniform(n0.x, n1.x), uniform(n0.y, n1.y), uniform(n0.z, n1.z));
+    const glm::dvec3 p = win->lattice().to_world(l);
+    ASSERT_EQ(win->inside(p), whole.inside(p)) << i;
+    inside += whole.inside(p);
+  }
+  EXPECT_GT(inside, 20);
+  size_t spans = 0;
+  for (int i = 0; i < 200; ++i) {
+    const glm::ivec2 uv(int(uniform(n0.x, n1.x)), int(uniform(n0.y, n1.y)));
+    const std::vector<Span> a = win->ray_spans(2, uv), b = whole.ray_spans(2, uv);
+    ASSERT_EQ(a.size(), b.size()) << i;
+    for (size_t k = 0; k < a.size(); ++k) {
+      EXPECT_EQ(a[k].enter.depth, b[k].enter.depth);
+      EXPECT_EQ(a[k].exit.depth, b[k].exit.depth);
+      EXPECT_EQ(a[k].exit.material, b[k].exit.material);
+    }
+    spans += a.size();
+  }
+  EXPECT_GT(spans, 100u);
+}
+
+TEST(Store, EvictionUnderATinyBudgetChangesNoResult) {
+  const World& whole = whole_world();
+  PagingOptions opts;
+  opts.memory_budget_bytes = 64 << 10;
+  PagedWorld paged(small_source(), opts);
+  const SourceBox box = paged.layout().box;
+  size_t max_window = 0;
+  // Walk 2 x 2 column windows across the box, twice (the second pass pages
+  // evicted chunks in again).
+  for (int pass = 0; pass < 2; ++pass) {
+    for (int y = box.chunk_origin.y; y < box_end(box).y; y += 2) {
+      for (int x = box.chunk_origin.x; x < box_end(box).x; x += 2) {
+        const glm::ivec3 lo(x, y, box.chunk_origin.z), hi(x + 2, y + 2, box_end(box).z);
+        Result<World> w = paged.window(lo, hi);
+        ASSERT_TRUE(w.ok()) << w.status().to_string();
+        EXPECT_TRUE(same_chunks_as(*w, whole)) << x << " " << y;
+        const PagingStats s = paged.stats();
+        EXPECT_LE(s.resident_bytes, std::max(opts.memory_budget_bytes, window_bytes(*w)));
+        max_window = std::max(max_window, window_bytes(*w));
+      }
+    }
+  }
+  const PagingStats s = paged.stats();
+  // While a window is made: the trimmed cache, the last window and this one.
+  EXPECT_LE(s.peak_resident_bytes, opts.memory_budget_bytes + 2 * max_window);
+  EXPECT_GT(s.evictions, 0u);
+  EXPECT_GT(s.page_ins, size_t(box.slots()));  // some chunks read twice
+  EXPECT_EQ(s.dirty, 0u);
+  // A window larger than the budget is still made, and counted.
+  Result<World> all = paged.window(box.chunk_origin, box_end(box));
+  ASSERT_TRUE(all.ok());
+  EXPECT_TRUE(same_chunks_as(*all, whole));
+  EXPECT_EQ(paged.stats().windows_over_budget, 1u);
+  EXPECT_EQ(paged.stats().resident_bytes, window_bytes(*all));  // pinned, not evicted
+}
+
+TEST(Store, CancelledWindowReturnsCancelled) {
+  PagedWorld paged(small_source());
+  Context ctx;
+  ctx.cancel();
+  const SourceBox box = paged.layout().box;
+  Result<World> w = paged.window(box.chunk_origin, box_end(box), &ctx);
+  EXPECT_EQ(w.status().code(), ErrorCode::kCancelled);
+  EXPECT_EQ(paged.stats().page_ins, 0u);
+}
+
+// Digs a sphere into a window with the CSG editor and returns the edited
+// world and its dirty chunks.
+std::pair<World, std::vector<glm::ivec3>> dig(const World& window, const glm::dvec3& centre) {
+  WorldEditor editor(window);
+  Result<EditReceipt> r = editor.apply(Brush::sphere(centre, 1.2), EditOp::kSubtract);
+  EXPECT_TRUE(r.ok()) << r.status().to_string();
+  std::vector<glm::ivec3> chunks;
+  for (const DirtyChunk& d : editor.take_dirty()) chunks.push_back(d.chunk);
+  return {editor.world(), chunks};
+}
+
+TEST(Store, EditsPutBackSurviveEvictionUntilTaken) {
+  const World& whole = whole_world();
+  PagingOptions opts;
+  opts.memory_budget_bytes = 64 << 10;
+  auto source = small_source();
+  PagedWorld paged(source, opts);
+  const SourceBox box = paged.layout().box;
+  const glm::ivec3 lo = box.chunk_origin + glm::ivec3(1, 1, 0), hi = lo + glm::ivec3(3, 3, box.chunk_dims.z);
+  Result<World> win = paged.window(lo, hi);
+  ASSERT_TRUE(win.ok());
+  // The ground's surface near the window's middle.
+  const glm::dvec3 mid = win->lattice().to_world(glm::dvec3(win->node_min() + win->node_end()) * 0.5);
+  double ground = mid.z;
+  for (double z = win->box().max.z; z > win->box().min.z; z -= 0.1) {
+    if (win->inside({mid.x, mid.y, z})) {
+      ground = z;
+      break;
+    }
+  }
+  auto [edited, dirty] = dig(*win, {mid.x, mid.y, ground});
+  ASSERT_FALSE(dirty.empty());
+  ASSERT_EQ(edited.chunk_origin(), win->chunk_origin());  // the dig stayed inside
+  ASSERT_TRUE(paged.put(edited, dirty).ok());
+  EXPECT_EQ(paged.stats().dirty, dirty.size());
+  // Page everything else out: a window at the far corner under 64 KiB.
+  ASSERT_TRUE(paged.window(box_end(box) - glm::ivec3(2, 2, box.chunk_dims.z), box_end(box)).ok());
+  ASSERT_TRUE(paged.window(box_end(box) - glm::ivec3(1, 2, box.chunk_dims.z), box_end(box)).ok());
+  EXPECT_GT(paged.stats().evictions, 0u);
+  Result<World> back = paged.window(lo, hi);
+  ASSERT_TRUE(back.ok());
+  EXPECT_TRUE(same_chunks_as(*back, edited));
+  EXPECT_FALSE(same_chunks_as(*back, whole));  // the dig is there
+  // take_dirty hands them out once, sorted, and they become clean.
+  std::vector<DirtyStoredChunk> taken = paged.take_dirty();
+  ASSERT_EQ(taken.size(), dirty.size());
+  for (size_t i = 0; i < taken.size(); ++i) {
+    EXPECT_EQ(taken[i].chunk, dirty[i]);
+    EXPECT_TRUE(same_chunk(taken[i].data.kind, taken[i].data.data.get(), edited.chunk_kind(dirty[i]),
+                           edited.chunk(dirty[i]), kC));
+  }
+  EXPECT_TRUE(paged.take_dirty().empty());
+  EXPECT_EQ(paged.stats().dirty, 0u);
+  // Saved into an overlay over the generator, a fresh pager serves them.
+  auto overlay = std::make_shared<OverlaySource>(source);
+  for (const DirtyStoredChunk& d : taken) ASSERT_TRUE(overlay->set(d.chunk, d.data).ok());
+  PagedWorld reopened(overlay, opts);
+  Result<World> saved = reopened.window(lo, hi);
+  ASSERT_TRUE(saved.ok());
+  EXPECT_TRUE(same_chunks_as(*saved, edited));
+}
+
+TEST(Store, PutRefusesChunksOutsideTheBoxesOrAnotherLattice) {
+  PagedWorld paged(small_source());
+  const SourceBox box = paged.layout().box;
+  Result<World> win = paged.window(box.chunk_origin, box.chunk_origin + 2);
+  ASSERT_TRUE(win.ok());
+  const glm::ivec3 outside_window[] = {box.chunk_origin + 3};
+  Status s = paged.put(*win, outside_window);
+  EXPECT_EQ(s.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(s.message().find("edited world's box"), std::string::npos) << s.message();
+  World other = build_terrain(small_terrain(), 0.5, kC).value();
+  const glm::ivec3 one[] = {other.chunk_origin()};
+  s = paged.put(other, one);
+  EXPECT_NE(s.message().find("lattice"), std::string::npos) << s.message();
+  EXPECT_EQ(paged.stats().dirty, 0u);
+}
+
+TEST(Store, OverlayLooksInItsChunksThenTheLowerLayerThenTheBase) {
+  auto source = small_source();
+  const SourceBox box = source->layout().box;
+  const glm::ivec3 a = box.chunk_origin, b = box.chunk_origin + 1;
+  int lower_calls = 0;
+  ChunkFinder lower = [&](const glm::ivec3& ch) -> Result<std::optional<StoredChunk>> {
+    ++lower_calls;
+    if (ch == b) return std::optional<StoredChunk>(StoredChunk{ChunkKind::kSolid, nullptr});
+    return std::optional<StoredChunk>();
+  };
+  OverlaySource overlay(source, lower);
+  ASSERT_TRUE(overlay.set(a, {ChunkKind::kSolid, nullptr}).ok());
+  EXPECT_EQ(overlay.read(a)->kind, ChunkKind::kSolid);
+  EXPECT_EQ(lower_calls, 0);
+  EXPECT_EQ(overlay.read(b)->kind, ChunkKind::kSolid);  // from the lower layer
+  const glm::ivec3 c = box_end(box) - 1;
+  EXPECT_EQ(overlay.read(c)->kind, source->read(c)->kind);  // from the base
+  EXPECT_EQ(lower_calls, 2);
+  EXPECT_EQ(overlay.set(box_end(box), {}).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(overlay.set(a, {ChunkKind::kMixed, nullptr}).code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(overlay.size(), 1u);
+}
+
+size_t resident_set_bytes() {
+  std::ifstream statm("/proc/self/statm");
+  size_t pages = 0, resident = 0;
+  statm >> pages >> resident;
+  return resident * 4096;
+}
+
+TEST(Store, KilometreSourceMakesAWindowAtItsSizeOnly) {
+  TerrainConfig big;
+  big.size_x = 4000.0;
+  big.size_y = 4000.0;
+  const size_t rss_before = resident_set_bytes();
+  const auto t0 = std::chrono::steady_clock::now();
+  Result<std::shared_ptr<const ImplicitSource>> source = make_terrain_source(big, 0.2, 32);
+  ASSERT_TRUE(source.ok()) << source.status().to_string();
+  const SourceBox box = (*source)->layout().box;
+  EXPECT_GE(box.chunk_dims.x, 625);  // 20000 cells + padding at h = 0.2
+  PagingOptions opts;
+  opts.memory_budget_bytes = 16 << 20;
+  PagedWorld paged(*source, opts);
+  Result<World> win = paged.window_around({2000.0, 2000.0, 6.0}, 10.0);  // 4 x 4 columns
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ASSERT_TRUE(win.ok()) << win.status().to_string();
+  EXPECT_LE(win->chunk_dims().x * win->chunk_dims().y, 16);
+  // Deterministic: a second source hands out the same chunks.
+  auto again = make_terrain_source(big, 0.2, 32).value();
+  win->for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk* data) {
+    StoredChunk c = again->read(ch).value();
+    EXPECT_TRUE(same_chunk(kind, data, c.kind, c.data.get(), 32));
+  });
+  const PagingStats s = paged.stats();
+  std::printf("4 km source: box %d x %d x %d chunks, window %d x %d x %d in %.3f s, cache %zu bytes, "
+              "RSS growth %.1f MiB\n",
+              box.chunk_dims.x, box.chunk_dims.y, box.chunk_dims.z, win->chunk_dims().x,
+              win->chunk_dims().y, win->chunk_dims().z, seconds, s.resident_bytes,
+              double(resident_set_bytes() - std::min(rss_before, resident_set_bytes())) / 1048576.0);
+  EXPECT_LT(s.resident_bytes, size_t(16) << 20);
+  EXPECT_LT(resident_set_bytes(), rss_before + (size_t(96) << 20));
+  EXPECT_LT(seconds, 5.0);
+  // The middle of the world has ground: mixed chunks were generated.
+  EXPECT_GT(s.resident_mixed, 0u);
+}
+
+TEST(Store, BadLayoutsAreRefusedNamingTheField) {
+  SourceLayout good;
+  good.box.chunk_dims = glm::ivec3(4);
+  EXPECT_TRUE(check_source_layout(good).ok());
+  auto refused = [](const SourceLayout& l, const char* field) {
+    Status s = check_source_layout(l);
+    EXPECT_FALSE(s.ok()) << field;
+    EXPECT_NE(s.message().find(field), std::string::npos) << s.message();
+  };
+  SourceLayout l = good;
+  l.box.chunk_dims.y = 0;
+  refused(l, "box.chunk_dims.y = 0");
+  l = good;
+  l.lattice.cell_size = std::nan("");
+  refused(l, "lattice.cell_size = nan");
+  l = good;
+  l.chunk_size = 7;
+  refused(l, "chunk_size = 7");
+  l = good;
+  l.box.chunk_origin.x = 40000;  // nodes up to 1.28e6 > 2^20
+  refused(l, "node range on x");
+  l = good;
+  l.chunk_size = 8;
+  l.box.chunk_origin = glm::ivec3(-65536);
+  l.box.chunk_dims = glm::ivec3(131072);  // 2^51 slots
+  refused(l, "chunk slots exceeds");
+  Result<std::shared_ptr<const ImplicitSource>> bad_h = make_terrain_source(small_terrain(), std::nan(""), 32);
+  ASSERT_FALSE(bad_h.ok());
+  EXPECT_NE(bad_h.status().message().find("cell_size"), std::string::npos);
+  EXPECT_FALSE(make_terrain_source(small_terrain(), 0.2, 7).ok());
+  TerrainConfig zero = small_terrain();
+  zero.size_x = 0.0;
+  EXPECT_NE(make_terrain_source(zero).status().message().find("size_x"), std::string::npos);
+  // Windows that miss the box, and bad foci.
+  PagedWorld paged(small_source());
+  const SourceBox box = paged.layout().box;
+  EXPECT_EQ(paged.window(box_end(box), box_end(box) + 2).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(paged.window_around(glm::dvec3(std::nan("")), 1.0).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(paged.window_around(glm::dvec3(1.0), -1.0).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(paged.window_around(glm::dvec3(1e300), 1.0).status().code(), ErrorCode::kInvalidArgument);
+}
+
+double thread_cpu_seconds() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// Timings for the report: not run by default.
+// ./build/tests/ldc_tests --gtest_also_run_disabled_tests --gtest_filter='StoreBench*'
+TEST(StoreBench, DISABLED_GenerationThroughput) {
+  TerrainConfig big;
+  big.size_x = 4000.0;
+  big.size_y = 4000.0;
+  auto source = make_terrain_source(big, 0.2, 32).value();
+  const SourceBox box = source->layout().box;
+  const glm::ivec3 mid = box.chunk_origin + box.chunk_dims / 2;
+  for (int threads : {1, 2}) {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
+    // Single chunks: mixed vs uniform.
+    double mixed_s = 0, uniform_s = 0;
+    int mixed = 0, uniform = 0;
+    for (int i = 0; i < 16; ++i) {
+      for (int z = box.chunk_origin.z; z < box_end(box).z; ++z) {
+        const double t0 = thread_cpu_seconds();  // CPU time: the test machine may be shared
+        StoredChunk c = source->read({mid.x + 40 + i, mid.y - 40, z}).value();
+        const double s = thread_cpu_seconds() - t0;
+        (c.kind == ChunkKind::kMixed ? mixed_s : uniform_s) += s;
+        ++(c.kind == ChunkKind::kMixed ? mixed : uniform);
+      }
+    }
+    // A window of 8 x 8 columns (x 3-4 chunks up) around a focus.
+    PagedWorld paged(source);
+    const glm::ivec3 lo(mid.x + threads * 20, mid.y, box.chunk_origin.z);
+    const auto t0 = std::chrono::steady_clock::now();
+    World w = paged.window(lo, lo + glm::ivec3(8, 8, 4)).value();
+    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const PagingStats st = paged.stats();
+    std::printf("threads %d: mixed chunk %.2f ms CPU (%d), uniform chunk %.4f ms CPU (%d); window %dx%dx%d: %.3f s, "
+                "%zu chunks (%zu mixed) = %.0f chunks/s, cache %.2f MiB\n",
+                threads, 1e3 * mixed_s / std::max(mixed, 1), mixed, 1e3 * uniform_s / std::max(uniform, 1),
+                uniform, w.chunk_dims().x, w.chunk_dims().y, w.chunk_dims().z, s, st.page_ins,
+                st.resident_mixed, double(st.page_ins) / s, double(st.resident_bytes) / 1048576.0);
+  }
+}
+
+}  // namespace
+}  // namespace ldc
