@@ -139,33 +139,65 @@ std::vector<glm::ivec3> PagedWorld::use_cached(const World& world) {
 // Reads the missing chunks in parallel and caches those read; returns the
 // first error in chunk order, or kCancelled.
 Status PagedWorld::page_in(const std::vector<glm::ivec3>& missing, Context* ctx) {
-  std::vector<StoredChunk> read(missing.size());
-  std::vector<Status> errors(missing.size());
-  detail::ProgressCounter progress(ctx, "page", missing.size());
-  tbb::parallel_for(size_t{0}, missing.size(), [&](size_t i) {
-    if (progress.cancelled()) {
-      errors[i] = detail::cancelled_status("paged world");
-      return;
-    }
-    Result<StoredChunk> r = source_->read(missing[i]);
-    if (r.ok()) {
-      read[i] = std::move(r).value();
-    } else {
-      errors[i] = r.status();
-    }
+  std::vector<Result<StoredChunk>> read = read_chunks(missing, ctx);
+  return cache_read(missing, read);
+}
+
+// Reads the chunks from the source in parallel (no lock needed: the source
+// is thread-safe and nothing of the cache is touched).
+std::vector<Result<StoredChunk>> PagedWorld::read_chunks(const std::vector<glm::ivec3>& chunks, Context* ctx) const {
+  std::vector<Result<StoredChunk>> read(chunks.size(), detail::cancelled_status("paged world"));
+  detail::ProgressCounter progress(ctx, "page", chunks.size());
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t i) {
+    if (progress.cancelled()) return;
+    read[i] = source_->read(chunks[i]);
     progress.step();
   });
+  return read;
+}
+
+// Holds the lock. Caches the chunks read that are not cached yet (a
+// prefetch may find chunks a window or put() cached meanwhile: those stay);
+// returns the first error in chunk order.
+Status PagedWorld::cache_read(const std::vector<glm::ivec3>& chunks, std::vector<Result<StoredChunk>>& read) {
   Status first_error;
-  for (size_t i = 0; i < missing.size(); ++i) {
-    if (errors[i].ok()) {
-      insert(missing[i], std::move(read[i]), false);
-      ++stats_.page_ins;
-    } else if (first_error.ok()) {
-      first_error = errors[i];
+  for (size_t i = 0; i < chunks.size(); ++i) {
+    if (!read[i].ok()) {
+      if (first_error.ok()) first_error = read[i].status();
+      continue;
     }
+    if (cache_.count(chunk_key(chunks[i])) != 0) continue;
+    insert(chunks[i], std::move(read[i]).value(), false);
+    ++stats_.page_ins;
   }
   stats_.peak_resident_bytes = std::max(stats_.peak_resident_bytes, stats_.resident_bytes);
   return first_error;
+}
+
+Status PagedWorld::prefetch(const glm::ivec3& chunk_lo, const glm::ivec3& chunk_hi, Context* ctx) {
+  const SourceBox& box = layout().box;
+  const glm::ivec3 lo = glm::max(chunk_lo, box.chunk_origin);
+  const glm::ivec3 hi = glm::min(chunk_hi, box.chunk_origin + box.chunk_dims);
+  if (glm::any(glm::lessThanEqual(hi, lo))) return {};
+  const glm::i64vec3 dims = glm::i64vec3(hi - lo);
+  if (dims.x * dims.y * dims.z > kMaxChunkSlots) {
+    return {ErrorCode::kTooLarge, "paged world: prefetch of " + chunk_text(lo) + " .. " + chunk_text(hi) +
+                                      " is larger than a window may be"};
+  }
+  std::vector<glm::ivec3> missing;
+  {
+    std::lock_guard lock(mutex_);
+    for (int z = lo.z; z < hi.z; ++z)
+      for (int y = lo.y; y < hi.y; ++y)
+        for (int x = lo.x; x < hi.x; ++x)
+          if (cache_.count(chunk_key({x, y, z})) == 0) missing.emplace_back(x, y, z);
+  }
+  std::vector<Result<StoredChunk>> read = read_chunks(missing, ctx);
+  std::lock_guard lock(mutex_);
+  Status s = cache_read(missing, read);
+  stats_.prefetched += missing.size();
+  trim_to_budget();
+  return s;
 }
 
 // Sets every chunk of the world from the cache (all present after page_in)

@@ -154,6 +154,7 @@ struct PagingStats {
   size_t dirty = 0;                 // chunks put() and not yet taken
   size_t windows = 0;               // windows made
   size_t windows_over_budget = 0;   // windows whose own chunks exceeded the budget
+  size_t prefetched = 0;            // chunks prefetch() looked for that were not cached
 };
 
 // A chunk put() back and not yet saved.
@@ -181,8 +182,11 @@ struct DirtyStoredChunk {
 // the source (e.g. an OverlaySource or a store file it reads) first.
 //
 // Thread safety: one owner thread calls window(), put() and take_dirty();
-// every method holds an internal lock, so stats() is safe from any thread.
-// window() reads missing chunks from the source in parallel (TBB).
+// one other thread may call prefetch() meanwhile; every method holds an
+// internal lock, so stats() is safe from any thread. window() reads missing
+// chunks from the source in parallel (TBB) under the lock; prefetch() reads
+// them outside it, so a worker can page ahead of the camera while the owner
+// makes windows from what is cached.
 class PagedWorld {
  public:
   // `source` must not be null; it is shared, and read from window() only.
@@ -201,6 +205,15 @@ class PagedWorld {
   // around focus [Units: m]. Errors: a non-finite focus or a radius < 0 or
   // not finite (kInvalidArgument), then those of window().
   Result<World> window_around(const glm::dvec3& focus, double radius_m, Context* ctx = nullptr);
+
+  // Reads the chunks of [chunk_lo, chunk_hi) (clipped to the source's box)
+  // that are not cached into the cache, as clean chunks, without making a
+  // window; the source is read outside the lock (see Thread safety). A chunk
+  // a window or put() caches meanwhile is kept, not replaced. The cache is
+  // then trimmed to the budget (the latest window's chunks stay). Errors:
+  // kTooLarge for a box over kMaxChunkSlots, the source's first error (the
+  // other chunks are cached), kCancelled through ctx.
+  Status prefetch(const glm::ivec3& chunk_lo, const glm::ivec3& chunk_hi, Context* ctx = nullptr);
 
   // Takes the listed chunks of `edited` (a window after an edit; its
   // lattice and chunk size must be the source's) back as dirty. All or
@@ -226,6 +239,8 @@ class PagedWorld {
   Result<World> make_window(const glm::ivec3& lo, const glm::ivec3& hi, Context* ctx);
   std::vector<glm::ivec3> use_cached(const World& world);
   Status page_in(const std::vector<glm::ivec3>& missing, Context* ctx);
+  std::vector<Result<StoredChunk>> read_chunks(const std::vector<glm::ivec3>& chunks, Context* ctx) const;
+  Status cache_read(const std::vector<glm::ivec3>& chunks, std::vector<Result<StoredChunk>>& read);
   void fill(World& world);
   void insert(const glm::ivec3& chunk, StoredChunk data, bool dirty);
   void touch(Entry& entry);

@@ -3,6 +3,8 @@
 // back survive eviction, and a kilometre-wide source costs its window only.
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -297,6 +299,44 @@ TEST(Store, EditsPutBackSurviveEvictionUntilTaken) {
   Result<World> saved = reopened.window(lo, hi);
   ASSERT_TRUE(saved.ok());
   EXPECT_TRUE(same_chunks_as(*saved, edited));
+}
+
+// A worker prefetching ahead while the owner makes windows: every window
+// still equals the whole build, the prefetched box is then served from the
+// cache without a page-in, and an edit put() meanwhile is never replaced by
+// a prefetched copy of the source's chunk.
+TEST(Store, PrefetchOnAWorkerFillsTheCacheAndChangesNoResult) {
+  const World& whole = whole_world();
+  PagedWorld paged(small_source());
+  const SourceBox box = paged.layout().box;
+  const glm::ivec3 lo = box.chunk_origin, hi = box_end(box);
+  std::thread worker([&] { EXPECT_TRUE(paged.prefetch(lo, hi).ok()); });
+  for (int x = lo.x; x < hi.x; ++x) {
+    Result<World> w = paged.window({x, lo.y, lo.z}, {x + 1, hi.y, hi.z});
+    ASSERT_TRUE(w.ok()) << w.status().to_string();
+    EXPECT_TRUE(same_chunks_as(*w, whole)) << x;
+  }
+  worker.join();
+  const size_t read = paged.stats().page_ins;
+  EXPECT_EQ(read, size_t(box.slots()));  // each chunk read into the cache once
+  Result<World> all = paged.window(lo, hi);
+  ASSERT_TRUE(all.ok());
+  EXPECT_TRUE(same_chunks_as(*all, whole));
+  EXPECT_EQ(paged.stats().page_ins, read);
+
+  // An edited chunk put() back stays what was put, whatever a prefetch finds.
+  PagedWorld fresh(small_source());
+  Result<World> window = fresh.window(lo, hi);
+  ASSERT_TRUE(window.ok());
+  const glm::dvec3 centre = 0.5 * (window->box().min + window->box().max);
+  auto [edited, dirty] = dig(*window, centre);
+  ASSERT_FALSE(dirty.empty());
+  ASSERT_TRUE(fresh.put(edited, dirty).ok());
+  ASSERT_TRUE(fresh.prefetch(lo, hi).ok());
+  Result<World> again = fresh.window(lo, hi);
+  ASSERT_TRUE(again.ok());
+  for (const glm::ivec3& c : dirty) EXPECT_EQ(again->chunk_shared(c), edited.chunk_shared(c));
+  EXPECT_EQ(fresh.prefetch({-1000, -1000, -1000}, {-999, -999, -999}).code(), ErrorCode::kOk);  // outside: nothing
 }
 
 TEST(Store, PutRefusesChunksOutsideTheBoxesOrAnotherLattice) {
