@@ -15,9 +15,15 @@
 #include <zstd.h>
 
 #include "ldc/detail/crc32.h"
+#include "ldc/internal/chunk_codec.h"
 #include "ldc/internal/validate_work.h"
 
 namespace ldc {
+
+// Defined below, outside the anonymous namespace: the chunk log shares them.
+using detail::chunk_raw_bytes;
+using detail::decode_chunk;
+
 namespace {
 
 // Whether `size` bytes at p have the stored CRC-32. Fuzzing builds accept
@@ -119,11 +125,15 @@ void write_family(Writer& w, const RayFamily& f, int c) {
   }
 }
 
-std::vector<uint8_t> chunk_raw_bytes(const Chunk& chunk, int c) {
+}  // namespace
+
+std::vector<uint8_t> detail::chunk_raw_bytes(const Chunk& chunk, int c) {
   Writer w;
   for (const RayFamily& f : chunk.axis) write_family(w, f, c);
   return std::move(w.bytes);
 }
+
+namespace {
 
 Status read_family(Reader& r, int c, RayFamily& out, const std::string& at) {
   if (!r.has(1)) return {ErrorCode::kCorruptData, at + ": truncated family flags"};
@@ -156,7 +166,9 @@ Status read_family(Reader& r, int c, RayFamily& out, const std::string& at) {
   return {};
 }
 
-Status decode_chunk(const uint8_t* data, size_t size, int c, Chunk& chunk, const std::string& at) {
+}  // namespace
+
+Status detail::decode_chunk(const uint8_t* data, size_t size, int c, Chunk& chunk, const std::string& at) {
   Reader r(data, size);
   for (int a = 0; a < 3; ++a) {
     Status s = read_family(r, c, chunk.axis[a], at + " axis " + axis_name(a));
@@ -165,6 +177,8 @@ Status decode_chunk(const uint8_t* data, size_t size, int c, Chunk& chunk, const
   if (r.left() != 0) return {ErrorCode::kCorruptData, at + ": " + std::to_string(r.left()) + " stray bytes"};
   return validate_chunk(chunk, c, true);
 }
+
+namespace {
 
 // --- header ---------------------------------------------------------------------
 
