@@ -1,0 +1,523 @@
+// A streaming fly-through of a procedural world far larger than memory: the
+// large-world proof for engine programmers (ldc/store.h, ldc/chunk_log.h).
+//
+// The landscape of build_terrain, 4 km x 4 km by default (about 1.2 million
+// chunk slots at h = 0.2 m), is never built whole: chunks are generated on
+// first touch (make_terrain_source) under a memory budget (PagedWorld).
+// Every frame, as a game would:
+//   1. page    the camera moves; a worker thread prefetches the chunks a
+//              second ahead of it (PagedWorld::prefetch), and the frame
+//              takes a window of the chunks around it from the cache;
+//   2. edit    once a second the player digs a sphere into the ground under
+//              the camera (WorldEditor on the window); the edited chunks go
+//              back to the pager as dirty (PagedWorld::put);
+//   3. save    right after, the edits are saved incrementally: appended to a
+//              crash-safe chunk log (ChunkLog::commit) and laid over the
+//              generator (OverlaySource), so they survive eviction;
+//   4. mesh    a mesh worker thread meshes the chunks that came into view
+//              or were edited (contour_chunk), nearest first; the frame
+//              collects what it finished and drops meshes of chunks that
+//              left the window;
+//   5. ray     a ground ray is cast under the camera (Queries).
+// Not done here yet: LOD meshes (every chunk is meshed at full resolution)
+// and nav updates around the player.
+// It prints the median, p95 and max of each stage and of the frame, the
+// peak resident memory, the pager's and the log's figures, and with --png
+// renders a few frames (render/render.h).
+//
+// Usage: flythrough [--frames N] [--budget-mb M] [--size-km K] [--speed V]
+//                   [--store PATH] [--png DIR] [--quiet]
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "contour/contour.h"
+#include "csg/csg.h"
+#include "ldc/chunk_log.h"
+#include "ldc/query.h"
+#include "ldc/store.h"
+#include "ldc/terrain.h"
+#include "render/render.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using ldc::Result;
+using ldc::Status;
+
+double ms_since(Clock::time_point start) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+struct Options {
+  int frames = 600;
+  double budget_mb = 512.0;
+  double size_km = 4.0;
+  double speed = 10.0;  // m/s, at 60 frames per second
+  std::string store = "out/flythrough.ldcs";
+  std::string png_dir;
+  bool quiet = false;
+};
+
+bool parse_options(int argc, char** argv, Options* o) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    const bool has_value = i + 1 < argc;
+    const auto number = [&](double lo, double hi, double* out) {
+      char* end = nullptr;
+      const double v = std::strtod(argv[++i], &end);
+      if (*end != '\0' || !(v >= lo && v <= hi)) {
+        std::fprintf(stderr, "%s %s: must be a number in %g .. %g\n", a.c_str(), argv[i], lo, hi);
+        return false;
+      }
+      *out = v;
+      return true;
+    };
+    double v = 0;
+    if (a == "--frames" && has_value) {
+      if (!number(1, 100000, &v)) return false;
+      o->frames = int(v);
+    } else if (a == "--budget-mb" && has_value) {
+      if (!number(16, 65536, &o->budget_mb)) return false;
+    } else if (a == "--size-km" && has_value) {
+      if (!number(0.1, 100, &o->size_km)) return false;
+    } else if (a == "--speed" && has_value) {
+      if (!number(0, 1000, &o->speed)) return false;
+    } else if (a == "--store" && has_value) {
+      o->store = argv[++i];
+    } else if (a == "--png" && has_value) {
+      o->png_dir = argv[++i];
+    } else if (a == "--quiet") {
+      o->quiet = true;
+    } else {
+      std::fprintf(stderr,
+                   "usage: flythrough [--frames N] [--budget-mb M] [--size-km K] [--speed V] [--store PATH] "
+                   "[--png DIR] [--quiet]\n");
+      return false;
+    }
+  }
+  return true;
+}
+
+constexpr int kFps = 60;
+constexpr double kViewRadius = 40.0;  // m: the window around the camera
+
+// One frame's measurements [ms].
+struct Frame {
+  double page = 0, edit = 0, save = 0, mesh = 0, ray = 0;
+  double total() const { return page + edit + save + mesh + ray; }
+};
+
+// The camera's ground track: a straight line across the world from near its
+// south-west corner, 8 m above the ground.
+glm::dvec2 track(const ldc::SourceLayout& layout, double size_m, double t_seconds, double speed) {
+  const glm::dvec2 start = glm::dvec2(layout.lattice.origin) + glm::dvec2(0.1 * size_m, 0.12 * size_m);
+  const glm::dvec2 dir = glm::normalize(glm::dvec2(1.0, 0.35));
+  return start + dir * (speed * t_seconds);
+}
+
+// Prefetches on its own thread the box a second ahead of the camera.
+class Prefetcher {
+ public:
+  explicit Prefetcher(ldc::PagedWorld& paged) : paged_(paged), thread_([this] { loop(); }) {}
+  ~Prefetcher() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+  void want(const glm::ivec3& lo, const glm::ivec3& hi) {
+    {
+      std::lock_guard lock(mutex_);
+      lo_ = lo;
+      hi_ = hi;
+      pending_ = true;
+    }
+    wake_.notify_one();
+  }
+
+ private:
+  void loop() {
+    std::unique_lock lock(mutex_);
+    while (true) {
+      wake_.wait(lock, [this] { return stop_ || pending_; });
+      if (stop_) return;
+      const glm::ivec3 lo = lo_, hi = hi_;
+      pending_ = false;
+      lock.unlock();
+      const Status s = paged_.prefetch(lo, hi);
+      if (!s.ok()) std::fprintf(stderr, "prefetch: %s\n", s.to_string().c_str());
+      lock.lock();
+    }
+  }
+
+  ldc::PagedWorld& paged_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  glm::ivec3 lo_{0}, hi_{0};
+  bool pending_ = false, stop_ = false;
+  std::thread thread_;
+};
+
+// Meshes chunks on its own thread, as an engine's job system would: the
+// frame hands it the current window (a snapshot: chunks are shared) and the
+// chunks to mesh, nearest first, and collects finished meshes next frame.
+class MeshWorker {
+ public:
+  explicit MeshWorker(const ldc::ContourConfig& config) : config_(config), thread_([this] { loop(); }) {}
+  ~MeshWorker() {
+    {
+      std::lock_guard lock(mutex_);
+      stop_ = true;
+    }
+    wake_.notify_one();
+    thread_.join();
+  }
+  // Replaces the queue: these chunks of this window, in this order.
+  void request(const ldc::World& window, std::vector<glm::ivec3> chunks) {
+    {
+      std::lock_guard lock(mutex_);
+      window_ = std::make_shared<const ldc::World>(window);
+      queue_ = std::move(chunks);
+    }
+    wake_.notify_one();
+  }
+  // The meshes finished since the last call.
+  std::vector<ldc::ChunkMesh> take() {
+    std::lock_guard lock(mutex_);
+    return std::exchange(done_, {});
+  }
+  size_t queued() {
+    std::lock_guard lock(mutex_);
+    return queue_.size();
+  }
+  double busy_ms() const { return busy_ms_.load(); }
+
+ private:
+  void loop() {
+    std::unique_lock lock(mutex_);
+    while (true) {
+      wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
+      if (stop_) return;
+      const glm::ivec3 chunk = queue_.front();
+      queue_.erase(queue_.begin());
+      std::shared_ptr<const ldc::World> window = window_;
+      lock.unlock();
+      const Clock::time_point start = Clock::now();
+      Result<ldc::ChunkMesh> m = ldc::contour_chunk(*window, chunk, config_);
+      busy_ms_ = busy_ms_.load() + ms_since(start);
+      lock.lock();
+      if (m.ok()) {
+        done_.push_back(std::move(m).value());
+      } else {
+        std::fprintf(stderr, "mesh: %s\n", m.status().to_string().c_str());
+      }
+    }
+  }
+
+  ldc::ContourConfig config_;
+  std::mutex mutex_;
+  std::condition_variable wake_;
+  std::shared_ptr<const ldc::World> window_;
+  std::vector<glm::ivec3> queue_;
+  std::vector<ldc::ChunkMesh> done_;
+  std::atomic<double> busy_ms_{0.0};
+  bool stop_ = false;
+  std::thread thread_;
+};
+
+// The chunk box of the window of `radius` m around a ground point.
+void chunk_box(const ldc::SourceLayout& layout, const glm::dvec2& xy, double radius, glm::ivec3* lo,
+               glm::ivec3* hi) {
+  const double c = layout.lattice.cell_size * layout.chunk_size;
+  const glm::dvec2 o = glm::dvec2(layout.lattice.origin);
+  *lo = glm::ivec3(glm::floor((xy - radius - o) / c), layout.box.chunk_origin.z);
+  *hi = glm::ivec3(glm::floor((xy + radius - o) / c) + 1.0, layout.box.chunk_origin.z + layout.box.chunk_dims.z);
+}
+
+struct Session {
+  std::shared_ptr<ldc::OverlaySource> overlay;
+  std::unique_ptr<ldc::PagedWorld> paged;
+  std::optional<ldc::ChunkLog> log;
+  ldc::World window;
+  glm::ivec3 window_lo{0}, window_hi{0};
+  bool window_stale = true;
+  std::map<std::tuple<int, int, int>, ldc::ChunkMesh> meshes;
+  std::vector<glm::ivec3> remesh;  // chunks to (re)mesh, nearest first
+  size_t triangles = 0, meshed = 0, digs = 0, saved_chunks = 0;
+  std::optional<double> ground_z;
+};
+
+std::tuple<int, int, int> key(const glm::ivec3& c) { return {c.x, c.y, c.z}; }
+
+// Chunks whose neighbours are all in the window: their meshes are whole.
+bool meshable(const Session& s, const glm::ivec3& c, const ldc::SourceLayout& layout) {
+  const glm::ivec3 lo = glm::max(s.window_lo + 1, layout.box.chunk_origin);
+  const glm::ivec3 hi = glm::min(s.window_hi - 1, layout.box.chunk_origin + layout.box.chunk_dims);
+  return glm::all(glm::greaterThanEqual(c, lo)) && glm::all(glm::lessThan(c, hi));
+}
+
+// Sets *changed when the frame's window is a new one.
+Status page(Session& s, Prefetcher& prefetcher, const ldc::SourceLayout& layout, const glm::dvec2& xy,
+            const glm::dvec2& ahead, bool* changed) {
+  glm::ivec3 lo, hi;
+  chunk_box(layout, ahead, kViewRadius, &lo, &hi);
+  prefetcher.want(lo, hi);
+  chunk_box(layout, xy, kViewRadius, &lo, &hi);
+  *changed = s.window_stale || lo != s.window_lo || hi != s.window_hi;
+  if (!*changed) return {};
+  Result<ldc::World> w = s.paged->window(lo, hi);
+  if (!w.ok()) return w.status();
+  s.window = std::move(w).value();
+  s.window_lo = s.window.chunk_origin();
+  s.window_hi = s.window_lo + s.window.chunk_dims();
+  s.window_stale = false;
+  // Drop meshes that left the window; queue the chunks that came in.
+  for (auto it = s.meshes.begin(); it != s.meshes.end();) {
+    const glm::ivec3 c(std::get<0>(it->first), std::get<1>(it->first), std::get<2>(it->first));
+    it = meshable(s, c, layout) ? std::next(it) : s.meshes.erase(it);
+  }
+  s.remesh.erase(std::remove_if(s.remesh.begin(), s.remesh.end(),
+                                [&](const glm::ivec3& c) { return !meshable(s, c, layout); }),
+                 s.remesh.end());
+  s.window.for_each_chunk([&](const glm::ivec3& c, ldc::ChunkKind, const ldc::Chunk*) {
+    if (meshable(s, c, layout) && !s.meshes.count(key(c)) &&
+        std::find(s.remesh.begin(), s.remesh.end(), c) == s.remesh.end())
+      s.remesh.push_back(c);
+  });
+  return {};
+}
+
+Status dig(Session& s, const glm::dvec2& xy, const ldc::ContourConfig& config) {
+  if (!s.ground_z) return {};
+  ldc::WorldEditor editor(s.window);
+  Result<ldc::EditReceipt> r = editor.apply(ldc::Brush::sphere({xy.x, xy.y, *s.ground_z}, 2.0), ldc::EditOp::kSubtract);
+  if (!r.ok()) return r.status();
+  const std::vector<ldc::DirtyChunk> dirty = editor.take_dirty();
+  std::vector<glm::ivec3> chunks;
+  for (const ldc::DirtyChunk& d : dirty) chunks.push_back(d.chunk);
+  s.window = editor.world();
+  if (Status p = s.paged->put(s.window, chunks); !p.ok()) return p;
+  for (const glm::ivec3& c : ldc::chunks_a_remesh_may_change(dirty, config, s.window.chunk_size())) {
+    if (meshable(s, c, s.paged->layout()) && std::find(s.remesh.begin(), s.remesh.end(), c) == s.remesh.end())
+      s.remesh.push_back(c);
+  }
+  ++s.digs;
+  return {};
+}
+
+Status save(Session& s) {
+  std::vector<ldc::DirtyStoredChunk> dirty = s.paged->take_dirty();
+  if (dirty.empty()) return {};
+  std::vector<std::pair<glm::ivec3, ldc::StoredChunk>> chunks;
+  for (const ldc::DirtyStoredChunk& d : dirty) {
+    if (Status st = s.overlay->set(d.chunk, d.data); !st.ok()) return st;
+    chunks.emplace_back(d.chunk, d.data);
+  }
+  s.saved_chunks += chunks.size();
+  return s.log->commit(chunks);
+}
+
+// Collects the meshes the worker finished (those still in view), then hands
+// it the chunks still to mesh, nearest first.
+void mesh(Session& s, MeshWorker& worker, const glm::dvec2& xy, bool window_changed) {
+  for (ldc::ChunkMesh& m : worker.take()) {
+    if (!meshable(s, m.chunk, s.paged->layout())) continue;
+    const glm::ivec3 chunk = m.chunk;
+    s.meshes[key(chunk)] = std::move(m);
+    s.remesh.erase(std::remove(s.remesh.begin(), s.remesh.end(), chunk), s.remesh.end());
+    ++s.meshed;
+  }
+  if (window_changed && !s.remesh.empty()) {
+    const double c = s.window.lattice().cell_size * s.window.chunk_size();
+    const glm::dvec2 o = glm::dvec2(s.window.lattice().origin);
+    std::stable_sort(s.remesh.begin(), s.remesh.end(), [&](const glm::ivec3& a, const glm::ivec3& b) {
+      return glm::length(o + (glm::dvec2(a) + 0.5) * c - xy) < glm::length(o + (glm::dvec2(b) + 0.5) * c - xy);
+    });
+    worker.request(s.window, s.remesh);
+  }
+  s.triangles = 0;
+  for (const auto& [k, m] : s.meshes) s.triangles += m.mesh.triangle_count();
+}
+
+void ground_ray(Session& s, const glm::dvec2& xy) {
+  ldc::Queries q(s.window);
+  const ldc::WorldBox box = s.window.box();
+  Result<ldc::RayHit> hit = q.ray_cast({{xy.x, xy.y, box.max.z + 1.0}, {0.0, 0.0, -1.0}});
+  s.ground_z = hit.ok() && hit->hit ? std::optional<double>(hit->point.z) : std::nullopt;
+}
+
+bool render_frame(const Session& s, const Options& o, int frame, const glm::dvec2& xy, const glm::dvec2& dir) {
+  char name[64];
+  std::snprintf(name, sizeof name, "flythrough_%04d.png", frame);
+  const std::string path = (std::filesystem::path(o.png_dir) / name).string();
+  ldc::CameraConfig view;
+  const double z = s.ground_z.value_or(10.0);
+  view.position = glm::dvec3(xy - 12.0 * dir, z + 9.0);
+  view.target = glm::dvec3(xy + 20.0 * dir, z - 2.0);
+  view.fov_degrees = 70.0;
+  view.width = 640;
+  view.height = 360;
+  ldc::RenderOptions options;
+  options.shadows = true;
+  ldc::Queries q(s.window);
+  Result<ldc::Camera> camera = ldc::Camera::make(view);
+  Result<ldc::Image> image = camera.ok() ? ldc::render(q, *camera, options) : camera.status();
+  const Status st = image.ok() ? ldc::write_png(*image, path) : image.status();
+  if (!st.ok()) {
+    std::fprintf(stderr, "render failed: %s\n", st.to_string().c_str());
+    return false;
+  }
+  std::printf("wrote %s\n", path.c_str());
+  return true;
+}
+
+double percentile(std::vector<double> v, double p) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, size_t(p * double(v.size() - 1) + 0.5))];
+}
+
+void print_summary(const std::vector<Frame>& frames) {
+  std::printf("| stage | median ms | p95 ms | max ms |\n|---|---|---|---|\n");
+  const std::pair<const char*, double Frame::*> stages[] = {
+      {"page", &Frame::page}, {"edit", &Frame::edit}, {"save", &Frame::save}, {"mesh", &Frame::mesh},
+      {"ray", &Frame::ray}};
+  for (const auto& [name, field] : stages) {
+    std::vector<double> v;
+    for (const Frame& f : frames) v.push_back(f.*field);
+    std::printf("| %s | %.3f | %.3f | %.3f |\n", name, percentile(v, 0.5), percentile(v, 0.95), percentile(v, 1.0));
+  }
+  std::vector<double> total;
+  for (const Frame& f : frames) total.push_back(f.total());
+  std::printf("| **frame** | %.3f | %.3f | %.3f |\n", percentile(total, 0.5), percentile(total, 0.95),
+              percentile(total, 1.0));
+}
+
+double peak_rss_mb() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_maxrss) / 1024.0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  if (!parse_options(argc, argv, &o)) return 2;
+  if (!o.png_dir.empty()) std::filesystem::create_directories(o.png_dir);
+  const std::filesystem::path store_dir = std::filesystem::path(o.store).parent_path();
+  if (!store_dir.empty()) std::filesystem::create_directories(store_dir);
+
+  ldc::TerrainConfig terrain;
+  terrain.size_x = terrain.size_y = 1000.0 * o.size_km;
+  terrain.arches = 64;
+  Result<std::shared_ptr<const ldc::ImplicitSource>> base = ldc::make_terrain_source(terrain, 0.2, 32);
+  if (!base.ok()) return std::fprintf(stderr, "%s\n", base.status().to_string().c_str()), 1;
+  const ldc::SourceLayout layout = (*base)->layout();
+  Session s;
+  s.overlay = std::make_shared<ldc::OverlaySource>(*base);
+  ldc::PagingOptions paging;
+  paging.memory_budget_bytes = size_t(o.budget_mb * 1024 * 1024);
+  s.paged = std::make_unique<ldc::PagedWorld>(s.overlay, paging);
+  ldc::ChunkLogCreateOptions create;
+  create.overwrite = true;
+  Result<ldc::ChunkLog> log = ldc::ChunkLog::create(o.store, layout, "flythrough terrain seed 1", create);
+  if (!log.ok()) return std::fprintf(stderr, "%s\n", log.status().to_string().c_str()), 1;
+  s.log.emplace(std::move(log).value());
+
+  std::printf("# flythrough: %.1f x %.1f km landscape (h = 0.2 m, %lld chunk slots), budget %.0f MB, %d frames at "
+              "%.0f m/s\n\n",
+              o.size_km, o.size_km, static_cast<long long>(layout.box.slots()), o.budget_mb, o.frames, o.speed);
+  ldc::ContourConfig contour;
+  std::vector<Frame> frames;
+  const int render_every = std::max(1, o.frames / 3);
+  double setup_ms = 0.0, worker_ms = 0.0;
+  {
+    Prefetcher prefetcher(*s.paged);
+    MeshWorker worker(contour);
+    // The first window and its meshes: what a game does behind its loading screen.
+    Clock::time_point start = Clock::now();
+    bool changed = false;
+    const glm::dvec2 first = track(layout, 1000.0 * o.size_km, 0.0, o.speed);
+    Status st = page(s, prefetcher, layout, first, track(layout, 1000.0 * o.size_km, 1.0, o.speed), &changed);
+    if (st.ok()) ground_ray(s, first);
+    mesh(s, worker, first, true);
+    while (st.ok() && worker.queued() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the last mesh in flight
+    mesh(s, worker, first, false);
+    setup_ms = ms_since(start);
+    if (!st.ok()) return std::fprintf(stderr, "setup: %s\n", st.to_string().c_str()), 1;
+    std::printf("setup (first window, %zu chunk meshes): %.0f ms\n\n", s.meshes.size(), setup_ms);
+    // Frames start every 1/60 s, as with vsync: the worker threads run in
+    // the time a frame leaves, as they would in a game.
+    const Clock::time_point loop_start = Clock::now();
+    for (int i = 0; i < o.frames; ++i) {
+      std::this_thread::sleep_until(loop_start + std::chrono::microseconds(int64_t(i) * 1000000 / kFps));
+      const double t = double(i) / kFps;
+      const glm::dvec2 xy = track(layout, 1000.0 * o.size_km, t, o.speed);
+      const glm::dvec2 ahead = track(layout, 1000.0 * o.size_km, t + 1.0, o.speed);
+      Frame f;
+      start = Clock::now();
+      st = page(s, prefetcher, layout, xy, ahead, &changed);
+      f.page = ms_since(start);
+      if (st.ok() && i % kFps == kFps / 2) {
+        start = Clock::now();
+        st = dig(s, xy, contour);
+        f.edit = ms_since(start);
+        changed = true;  // re-mesh what the dig changed
+        start = Clock::now();
+        if (st.ok()) st = save(s);
+        f.save = ms_since(start);
+      }
+      start = Clock::now();
+      if (st.ok()) mesh(s, worker, xy, changed);
+      f.mesh = ms_since(start);
+      start = Clock::now();
+      if (st.ok()) ground_ray(s, xy);
+      f.ray = ms_since(start);
+      if (!st.ok()) return std::fprintf(stderr, "frame %d: %s\n", i, st.to_string().c_str()), 1;
+      frames.push_back(f);
+      if (!o.quiet && (i % kFps == 0)) {
+        std::printf("frame %4d: at (%.0f, %.0f) %.2f ms, %zu chunk meshes (%zu triangles), resident %.1f MB\n", i,
+                    xy.x, xy.y, f.total(), s.meshes.size(), s.triangles,
+                    double(s.paged->stats().resident_bytes) / 1048576.0);
+      }
+      const glm::dvec2 dir = glm::normalize(ahead - xy);
+      if (!o.png_dir.empty() && (i % render_every == 0 || i == o.frames - 1) && !render_frame(s, o, i, xy, dir))
+        return 1;
+    }
+    worker_ms = worker.busy_ms();
+  }
+  std::printf("\n");
+  print_summary(frames);
+  const ldc::PagingStats ps = s.paged->stats();
+  const ldc::ChunkLogStats ls = s.log->stats();
+  std::printf("\npager: %zu page-ins (%zu by the prefetcher's requests), %zu hits, %zu evictions, resident %.1f MB "
+              "(peak %.1f MB) of %.0f MB\n",
+              ps.page_ins, ps.prefetched, ps.hits, ps.evictions, double(ps.resident_bytes) / 1048576.0,
+              double(ps.peak_resident_bytes) / 1048576.0, o.budget_mb);
+  std::printf("edits: %zu digs, %zu chunks saved in %llu commits, log %s %.1f KB\n", s.digs, s.saved_chunks,
+              static_cast<unsigned long long>(ls.commits), o.store.c_str(), double(ls.file_bytes) / 1024.0);
+  std::printf("meshes: %zu chunk meshes made on the mesh worker (%.0f ms of its time, %.1f ms each), %zu in view "
+              "(%zu triangles), %zu waiting\n",
+              s.meshed, worker_ms, s.meshed ? worker_ms / double(s.meshed) : 0.0, s.meshes.size(), s.triangles,
+              s.remesh.size());
+  std::printf("peak resident memory %.0f MB (setup %.0f ms, not in the frame figures)\n", peak_rss_mb(), setup_ms);
+  return 0;
+}
