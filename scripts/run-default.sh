@@ -13,7 +13,11 @@
 # Last, examples/game_loop plays 60 frames on the landscape (each frame: a dig
 # or a build, re-mesh, nav update, an agent re-planning, ground ray casts) and
 # prints the per-frame timings as a table with median, p95 and max; four of
-# its frames are rendered to out/game_loop/frame_*.png.
+# its frames are rendered to out/game_loop/frame_*.png. Then examples/flythrough
+# flies 5 s over a 4 km x 4 km landscape generated chunk by chunk under a
+# memory budget, digging once a second and saving the digs to
+# out/flythrough.ldcs, and prints its per-frame timings and peak memory
+# (frames in out/flythrough/).
 # Finally `ldc gi` lights the same view by cone tracing through the voxel cascades
 # (Vulkan; lavapipe without a GPU) and writes out/tunnel-gi.png.
 set -euo pipefail
@@ -29,5 +33,6 @@ mkdir -p out
 ./build/tools/ldc render out/tunnel.ldc -o out/tunnel.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
   --width 960 --height 540 --shadows --overlay out/path.json
 ./build/examples/game_loop/game_loop --frames 60 --png out/game_loop
+./build/examples/flythrough/flythrough --frames 300 --store out/flythrough.ldcs --png out/flythrough --quiet
 ./build/tools/ldc gi out/tunnel.ldc -o out/tunnel-gi.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 \
   --width 480 --height 270
