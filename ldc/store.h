@@ -42,6 +42,7 @@
 #include <glm/glm.hpp>
 
 #include "ldc/build.h"
+#include "ldc/chunk_log.h"
 #include "ldc/chunk_source.h"
 #include "ldc/context.h"
 #include "ldc/status.h"
@@ -255,5 +256,48 @@ class PagedWorld {
   PagingStats stats_;
   uint64_t window_ = 0;      // the latest window's number; its entries are pinned
 };
+
+// --- Stores: a chunk log over the base it describes -----------------------------
+
+// The landscape a store is built on, named by one line of text that the
+// chunk log's header carries (ChunkLog::base_description), e.g.
+//   "ldc-terrain 1 seed=1 size_x=4000 size_y=4000 ... cell_size=0.2 chunk_size=32"
+// Numbers are written with 17 significant digits, so the same chunks come
+// back bit for bit on any machine.
+struct TerrainSourceParams {
+  TerrainConfig config;
+  double cell_size = 0.2;  // [Units: m]
+  int chunk_size = 32;
+};
+std::string terrain_source_description(const TerrainConfig& config, double cell_size, int chunk_size);
+// Errors (kCorruptData): not a landscape description, a key missing, given
+// twice or unknown, a value that is not a finite number or out of range.
+Result<TerrainSourceParams> parse_terrain_source_description(const std::string& description);
+// The source a base description names (today: the landscape, through
+// make_terrain_source).
+Result<std::shared_ptr<const ChunkSource>> source_from_description(const std::string& description);
+
+// A large world on disk: a chunk log of its edited chunks over the base its
+// header describes. `source` reads the log's committed chunks, else the
+// base's: page windows from it with a PagedWorld, and save() what was put
+// back into the log. Thread safety: as ChunkLog's (save() must not run
+// beside reads of `source`, e.g. a prefetch: save between frames' paging).
+struct Store {
+  std::shared_ptr<ChunkLog> log;
+  std::shared_ptr<const ChunkSource> base;
+  std::shared_ptr<OverlaySource> source;  // log over base
+
+  // Commits the pager's dirty chunks (take_dirty) as one commit; nothing
+  // to commit writes nothing. On error the chunks are no longer dirty in
+  // the pager: keep the Store and retry only after reopening.
+  Status save(PagedWorld& paged);
+  ChunkFinder log_finder() const;
+};
+// A new store of the landscape (refuses an existing file unless overwrite).
+Result<Store> create_terrain_store(const std::string& path, const TerrainConfig& config, double cell_size = 0.2,
+                                   int chunk_size = 32, bool overwrite = false);
+// Opens a store in its last committed state; errors name the path, and a
+// log whose layout is not its description's is refused (kCorruptData).
+Result<Store> open_store(const std::string& path, const ChunkLogLimits& limits = {});
 
 }  // namespace ldc

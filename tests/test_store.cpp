@@ -507,5 +507,108 @@ TEST(StoreBench, DISABLED_GenerationThroughput) {
   }
 }
 
+// --- Stores: descriptions, a log over its base ---------------------------------
+
+// A description gives back the same landscape parameters, to the bit.
+TEST(Store, TerrainDescriptionsRoundTripExactly) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.1, 3000.0);
+  for (int i = 0; i < 50; ++i) {
+    TerrainConfig c;
+    c.seed = uint32_t(rng());
+    c.size_x = u(rng);
+    c.size_y = u(rng);
+    c.floor_z = u(rng) - 1500.0;
+    c.base_height = u(rng) / 100.0;
+    c.relief = u(rng) / 300.0;
+    c.overhang = u(rng) / 1000.0;
+    c.cave_radius = u(rng) / 1000.0;
+    c.arches = int(rng() % 65);
+    const double h = u(rng) / 5000.0;
+    Result<TerrainSourceParams> p = parse_terrain_source_description(terrain_source_description(c, h, 16));
+    ASSERT_TRUE(p.ok()) << p.status().to_string();
+    const TerrainConfig& d = p.value().config;
+    EXPECT_EQ(d.seed, c.seed);
+    EXPECT_EQ(d.size_x, c.size_x);
+    EXPECT_EQ(d.size_y, c.size_y);
+    EXPECT_EQ(d.floor_z, c.floor_z);
+    EXPECT_EQ(d.base_height, c.base_height);
+    EXPECT_EQ(d.relief, c.relief);
+    EXPECT_EQ(d.overhang, c.overhang);
+    EXPECT_EQ(d.cave_radius, c.cave_radius);
+    EXPECT_EQ(d.arches, c.arches);
+    EXPECT_EQ(p.value().cell_size, h);
+    EXPECT_EQ(p.value().chunk_size, 16);
+  }
+}
+
+TEST(Store, BadDescriptionsAreRefusedNamingTheKey) {
+  const std::string good = terrain_source_description(small_terrain(), kH, kC);
+  const std::pair<std::string, std::string> cases[] = {
+      {"flythrough terrain seed 1", "not a landscape description"},
+      {good + " extra=1", "unknown key 'extra'"},
+      {good + " seed=2", "key 'seed' given twice"},
+      {std::string(good).replace(good.find("size_x="), 7, "size_q="), "missing size_x"},
+      {std::string(good).replace(good.find("cell_size=") + 10, 4, "nan "), "cell_size = 'nan' is not a finite number"},
+      {std::string(good).replace(good.find("arches=") + 7, 1, "99"), "arches = 99 is not an integer in 0 .. 64"},
+      {good + " x", "'x' is not key=value"},
+  };
+  for (const auto& [text, expected] : cases) {
+    Result<TerrainSourceParams> p = parse_terrain_source_description(text);
+    ASSERT_FALSE(p.ok()) << text;
+    EXPECT_EQ(p.status().code(), ErrorCode::kCorruptData) << text;
+    EXPECT_NE(p.status().message().find(expected), std::string::npos) << p.status().message();
+  }
+}
+
+// Edits saved into a store come back after reopening it; every other chunk
+// is the generator's, and a log whose layout is not its description's is refused.
+TEST(Store, SavedEditsComeBackWhenTheStoreIsReopened) {
+  const std::string path = ::testing::TempDir() + "store_reopen.ldcs";
+  std::remove(path.c_str());
+  Result<Store> made = create_terrain_store(path, small_terrain(), kH, kC);
+  ASSERT_TRUE(made.ok()) << made.status().to_string();
+  World edited;
+  std::vector<glm::ivec3> dirty;
+  {
+    Store store = std::move(made).value();
+    PagedWorld paged(store.source);
+    Result<World> window = paged.window(store.source->layout().box.chunk_origin,
+                                        box_end(store.source->layout().box));
+    ASSERT_TRUE(window.ok());
+    const glm::dvec3 centre = 0.5 * (window->box().min + window->box().max);
+    std::tie(edited, dirty) = dig(*window, centre);
+    ASSERT_FALSE(dirty.empty());
+    ASSERT_TRUE(paged.put(edited, dirty).ok());
+    ASSERT_TRUE(store.save(paged).ok());
+    EXPECT_EQ(store.log->stats().live_chunks, dirty.size());
+    EXPECT_TRUE(store.save(paged).ok());  // nothing dirty: nothing written
+    EXPECT_EQ(store.log->stats().commits, 1u);
+  }
+  Result<Store> reopened = open_store(path);
+  ASSERT_TRUE(reopened.ok()) << reopened.status().to_string();
+  PagedWorld paged(reopened.value().source);
+  Result<World> again = paged.window(edited.chunk_origin(), edited.chunk_origin() + edited.chunk_dims());
+  ASSERT_TRUE(again.ok());
+  edited.for_each_chunk([&](const glm::ivec3& c, ChunkKind kind, const Chunk* data) {
+    EXPECT_TRUE(same_chunk(again->chunk_kind(c), again->chunk(c), kind, data, kC)) << c.x << " " << c.y << " " << c.z;
+  });
+  EXPECT_TRUE(validate(*again).ok);
+
+  // A log whose header layout is not the one its description makes.
+  const std::string wrong = ::testing::TempDir() + "store_wrong_layout.ldcs";
+  SourceLayout layout = make_terrain_source(small_terrain(), kH, kC).value()->layout();
+  layout.box.chunk_dims.x += 1;
+  ChunkLogCreateOptions overwrite;
+  overwrite.overwrite = true;
+  ASSERT_TRUE(ChunkLog::create(wrong, layout, terrain_source_description(small_terrain(), kH, kC), overwrite).ok());
+  Result<Store> refused = open_store(wrong);
+  ASSERT_FALSE(refused.ok());
+  EXPECT_EQ(refused.status().code(), ErrorCode::kCorruptData);
+  EXPECT_NE(refused.status().message().find("differ from those of its base description"), std::string::npos);
+  std::remove(path.c_str());
+  std::remove(wrong.c_str());
+}
+
 }  // namespace
 }  // namespace ldc

@@ -437,7 +437,7 @@ int main(int argc, char** argv) {
   s.paged = std::make_unique<ldc::PagedWorld>(s.overlay, paging);
   ldc::ChunkLogCreateOptions create;
   create.overwrite = true;
-  Result<ldc::ChunkLog> log = ldc::ChunkLog::create(o.store, layout, "flythrough terrain seed 1", create);
+  Result<ldc::ChunkLog> log = ldc::ChunkLog::create(o.store, layout, ldc::terrain_source_description(terrain, 0.2, 32), create);
   if (!log.ok()) return std::fprintf(stderr, "%s\n", log.status().to_string().c_str()), 1;
   s.log.emplace(std::move(log).value());
 
