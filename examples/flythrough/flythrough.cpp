@@ -437,7 +437,8 @@ int main(int argc, char** argv) {
   s.paged = std::make_unique<ldc::PagedWorld>(s.overlay, paging);
   ldc::ChunkLogCreateOptions create;
   create.overwrite = true;
-  Result<ldc::ChunkLog> log = ldc::ChunkLog::create(o.store, layout, ldc::terrain_source_description(terrain, 0.2, 32), create);
+  const std::string description = ldc::terrain_source_description(terrain, 0.2, 32);
+  Result<ldc::ChunkLog> log = ldc::ChunkLog::create(o.store, layout, description, create);
   if (!log.ok()) return std::fprintf(stderr, "%s\n", log.status().to_string().c_str()), 1;
   s.log.emplace(std::move(log).value());
 
