@@ -81,4 +81,13 @@ if(TARGET ldc_tool)
   # looks for it: <libdir>/ldc (its LDC_INSTALL_DIR, voxelize/CMakeLists.txt).
   get_target_property(ldc_vdb_plugin_dir ldc_vdb_plugin LDC_INSTALL_DIR)
   install(TARGETS ldc_vdb_plugin LIBRARY DESTINATION ${ldc_vdb_plugin_dir} COMPONENT tools)
+  # The other plugins (issue 22), likewise at their LDC_INSTALL_DIR: Draco
+  # (meshio/CMakeLists.txt), the Vulkan GI engine and the path-traced
+  # reference (gi_bridge/CMakeLists.txt), where built.
+  foreach(plugin ldc_draco_plugin ldc_gi_vulkan_plugin ldc_gi_reference_plugin)
+    if(TARGET ${plugin})
+      get_target_property(plugin_dir ${plugin} LDC_INSTALL_DIR)
+      install(TARGETS ${plugin} LIBRARY DESTINATION ${plugin_dir} COMPONENT tools)
+    endif()
+  endforeach()
 endif()

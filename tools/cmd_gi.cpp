@@ -2,22 +2,34 @@
 // primary visibility by our ray cast, irradiance from the cascades (16
 // cones per pixel), albedo and emission from the materials; --reference
 // puts the path-traced image (Embree on the contoured mesh) beside it.
+// The Vulkan engine and the path tracer are plugins (issue 22), dlopen()ed
+// only by --engine vulkan and --reference (gi_bridge/gi_plugin.h).
 #include <cmath>
 #include <cstdio>
 #include <numbers>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "camera.h"
 #include "common.h"
 #include "contour/contour.h"
 #include "gi_bridge/gi.h"
+#include "gi_bridge/gi_plugin.h"
 #include "json_inputs.h"
 #include "ldc/io.h"
 #include "ldc/query.h"
+#include "plugin.h"
 #include "render/render.h"
 #ifdef LDC_HAVE_GI_REFERENCE
 #include "gi_bridge/path_trace.h"
+#endif
+
+#if defined(LDC_HAVE_VULKAN) && !(defined(LDC_GI_VULKAN_PLUGIN_FILE) && defined(LDC_GI_VULKAN_PLUGIN_ABI))
+#error "the Vulkan GI plugin's file name, install path and ABI come from tools/CMakeLists.txt"
+#endif
+#if defined(LDC_HAVE_GI_REFERENCE) && !(defined(LDC_GI_REFERENCE_PLUGIN_FILE) && defined(LDC_GI_REFERENCE_PLUGIN_ABI))
+#error "the path-tracing plugin's file name, install path and ABI come from tools/CMakeLists.txt"
 #endif
 
 namespace ldc::tool {
@@ -64,6 +76,76 @@ Result<GiLights> parse_lights(const GiArgs& a, int up_axis) {
   return l;
 }
 
+// --- The plugins (gi_bridge/gi_plugin.h), each loaded once, on first use --
+
+#ifdef LDC_HAVE_VULKAN
+struct VulkanPlugin {  // a struct: see VdbPlugin in cmd_voxelize.cpp
+  LdcGiVulkanCreateFn create = nullptr;
+};
+
+Result<VulkanPlugin> load_vulkan_plugin() {
+  const PluginSpec spec{LDC_GI_VULKAN_PLUGIN_FILE, LDC_GI_VULKAN_PLUGIN_INSTALL_REL, "Vulkan GI", "ldc_gi_plugin_abi",
+                        LDC_GI_VULKAN_PLUGIN_ABI, {"ldc_gi_vulkan_create"}, "ldc_gi_plugin_layout",
+                        gi_plugin_layout()};
+  Result<LoadedPlugin> plugin = load_plugin(spec);
+  if (plugin.ok()) return VulkanPlugin{reinterpret_cast<LdcGiVulkanCreateFn>(plugin.value().symbols[0])};
+  return Status(ErrorCode::kUnsupported, std::string("--engine vulkan needs the Vulkan GI plugin " LDC_GI_VULKAN_PLUGIN_FILE
+                                                     ", which did not load (tried ") +
+                                             plugin.status().message() + "). --engine cpu needs no plugin");
+}
+
+const Result<VulkanPlugin>& vulkan_plugin() {
+  static const Result<VulkanPlugin> plugin = load_vulkan_plugin();
+  return plugin;
+}
+
+// make_vulkan_gi through the plugin: the same engine and the same messages.
+Result<std::unique_ptr<GiEngine>> make_vulkan_engine(const GiConfig& config, std::string* device) {
+  const Result<VulkanPlugin>& plugin = vulkan_plugin();
+  if (!plugin.ok()) return plugin.status();
+  std::unique_ptr<GiEngine> engine;
+  std::string message = "the Vulkan GI plugin failed without a message";
+  const int code = plugin.value().create(&config, &engine, device, &message);
+  if (code != 0) return Status(static_cast<ErrorCode>(code), message);
+  return engine;
+}
+#endif
+
+#ifdef LDC_HAVE_GI_REFERENCE
+struct ReferencePlugin {
+  LdcGiReferenceRadianceFn radiance = nullptr;
+};
+
+Result<ReferencePlugin> load_reference_plugin() {
+  const PluginSpec spec{LDC_GI_REFERENCE_PLUGIN_FILE, LDC_GI_REFERENCE_PLUGIN_INSTALL_REL, "path-tracing",
+                        "ldc_gi_plugin_abi", LDC_GI_REFERENCE_PLUGIN_ABI, {"ldc_gi_reference_radiance"},
+                        "ldc_gi_plugin_layout", gi_plugin_layout()};
+  Result<LoadedPlugin> plugin = load_plugin(spec);
+  if (plugin.ok()) return ReferencePlugin{reinterpret_cast<LdcGiReferenceRadianceFn>(plugin.value().symbols[0])};
+  return Status(ErrorCode::kUnsupported, std::string("--reference needs the path-tracing plugin " LDC_GI_REFERENCE_PLUGIN_FILE
+                                                     " (Embree), which did not load (tried ") +
+                                             plugin.status().message() + ")");
+}
+
+const Result<ReferencePlugin>& reference_plugin() {
+  static const Result<ReferencePlugin> plugin = load_reference_plugin();
+  return plugin;
+}
+#endif
+
+// A plugin that the arguments need and that does not load: its message
+// (naming the paths tried), before the world loads; empty when none.
+std::string missing_plugin(const GiArgs& a) {
+#ifdef LDC_HAVE_VULKAN
+  if (a.engine == "vulkan" && !vulkan_plugin().ok()) return vulkan_plugin().status().message();
+#endif
+#ifdef LDC_HAVE_GI_REFERENCE
+  if (a.reference && !reference_plugin().ok()) return reference_plugin().status().message();
+#endif
+  (void)a;
+  return {};
+}
+
 Result<std::unique_ptr<GiEngine>> make_engine(const std::string& name, const GiConfig& config, std::string* device) {
   if (name == "cpu") {
     *device = "cpu reference";
@@ -71,7 +153,7 @@ Result<std::unique_ptr<GiEngine>> make_engine(const std::string& name, const GiC
   }
   if (name != "vulkan") return Status(ErrorCode::kInvalidArgument, "--engine " + name + ": use vulkan or cpu");
 #ifdef LDC_HAVE_VULKAN
-  Result<std::unique_ptr<GiEngine>> gi = make_vulkan_gi(config, device);
+  Result<std::unique_ptr<GiEngine>> gi = make_vulkan_engine(config, device);
   if (gi.ok()) return gi;
   std::fprintf(stderr, "gi: %s; using the CPU reference\n", gi.status().message().c_str());
 #else
@@ -87,8 +169,8 @@ Result<RadianceImage> reference_image(const World& world, const Camera& cam, con
                                       const GiLights& lights, int bounces, int samples) {
   Result<ContourMesh> mesh = contour_world(world);
   if (!mesh.ok()) return mesh.status();
-  Result<std::unique_ptr<PathTracer>> pt = PathTracer::create(mesh.value(), mats, lights);
-  if (!pt.ok()) return pt.status();
+  const Result<ReferencePlugin>& plugin = reference_plugin();
+  if (!plugin.ok()) return plugin.status();
   RadianceImage img{cam.width(), cam.height(), std::vector<glm::vec3>(size_t(cam.width()) * size_t(cam.height()))};
   std::vector<Ray> rays;
   rays.reserve(img.pixels.size());
@@ -96,7 +178,10 @@ Result<RadianceImage> reference_image(const World& world, const Camera& cam, con
     for (int x = 0; x < cam.width(); ++x) rays.push_back(cam.pixel_ray(x, y));
   PathTraceConfig pc;
   pc.samples = samples;
-  if (Status s = pt.value()->radiance_along(rays, bounces, img.pixels, pc); !s.ok()) return s;
+  std::string message = "the path-tracing plugin failed without a message";
+  const int code = plugin.value().radiance(&mesh.value(), &mats, &lights, rays.data(), rays.size(), bounces, &pc,
+                                           img.pixels.data(), &message);
+  if (code != 0) return Status(static_cast<ErrorCode>(code), message);
   return img;
 }
 #endif
@@ -206,6 +291,7 @@ Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, 
 int run_gi(const GiArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
   if (Status s = check_args(a); !s.ok()) return fail("gi", s);
+  if (std::string missing = missing_plugin(a); !missing.empty()) return fail("gi", missing);
   const int up_axis = parse_up_axis(a.up, kLdcUpAxis).value();
   Result<GiLights> lights = parse_lights(a, up_axis);
   if (!lights.ok()) return fail("gi", lights.status());

@@ -1,15 +1,12 @@
 // ldc voxelize: solid occupancy and the six-face G-buffer of a world -> .vdb, or raw arrays + JSON header.
-#include <dlfcn.h>
-
 #include <cmath>
 #include <cstdio>
-#include <filesystem>
 #include <memory>
 #include <string>
-#include <system_error>
 #include <vector>
 
 #include "common.h"
+#include "plugin.h"
 #include "ldc/internal/vec_text.h"
 #include "ldc/io.h"
 #include "voxelize/vdb_plugin.h"
@@ -68,57 +65,17 @@ struct VdbPlugin {
   LdcVdbWriteFn write = nullptr;
 };
 
-std::filesystem::path exe_dir() {
-  std::error_code ec;
-  return std::filesystem::read_symlink("/proc/self/exe", ec).parent_path();
-}
-
-// Beside the tool (the build tree), then the install layout (<libdir>/ldc).
-std::vector<std::string> vdb_plugin_paths() {
-  const std::filesystem::path dir = exe_dir();
-  return {(dir / LDC_VDB_PLUGIN_FILE).string(),
-          (dir / LDC_VDB_PLUGIN_INSTALL_REL / LDC_VDB_PLUGIN_FILE).lexically_normal().string()};
-}
-
-// dlerror() text without the path it may begin with (the caller names it).
-std::string dl_reason(const std::string& path) {
-  const char* e = dlerror();
-  std::string reason = e != nullptr ? e : "unknown error";
-  if (reason.starts_with(path + ": ")) reason.erase(0, path.size() + 2);
-  return reason;
-}
-
-// Loads one candidate; on failure, why (without the path).
-Result<VdbPlugin> open_vdb_plugin(const std::string& path) {
-  // RTLD_LOCAL: OpenVDB's symbols stay out of the tool's namespace. The
-  // handle is never closed: OpenVDB and TBB keep state until exit.
-  void* handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
-  if (handle == nullptr) return Status(ErrorCode::kIoError, dl_reason(path));
-  auto abi = reinterpret_cast<LdcVdbAbiFn>(dlsym(handle, "ldc_vdb_plugin_abi"));
-  auto write = reinterpret_cast<LdcVdbWriteFn>(dlsym(handle, "ldc_vdb_plugin_write"));
-  const int plugin_abi = abi != nullptr ? abi() : -1;
-  std::string why;
-  if (abi == nullptr || write == nullptr) {
-    why = "not an ldc OpenVDB plugin (no ldc_vdb_plugin_abi / ldc_vdb_plugin_write)";
-  } else if (plugin_abi != LDC_VDB_PLUGIN_ABI) {
-    why = "plugin ABI " + std::to_string(plugin_abi) + ", this tool needs " + std::to_string(LDC_VDB_PLUGIN_ABI) +
-          " (a stale plugin from another ldc build)";
-  }
-  if (why.empty()) return VdbPlugin{write};
-  dlclose(handle);
-  return Status(ErrorCode::kUnsupported, why);
-}
-
+// Beside the tool (the build tree), then the install layout (<libdir>/ldc):
+// tools/plugin.h.
 Result<VdbPlugin> load_vdb_plugin() {
-  std::string tried;
-  for (const std::string& path : vdb_plugin_paths()) {
-    Result<VdbPlugin> plugin = open_vdb_plugin(path);
-    if (plugin.ok()) return plugin;
-    tried += (tried.empty() ? "" : "; ") + path + ": " + plugin.status().message();
-  }
+  const PluginSpec spec{LDC_VDB_PLUGIN_FILE, LDC_VDB_PLUGIN_INSTALL_REL, "OpenVDB", "ldc_vdb_plugin_abi",
+                        LDC_VDB_PLUGIN_ABI, {"ldc_vdb_plugin_write"}, nullptr, 0};
+  Result<LoadedPlugin> plugin = load_plugin(spec);
+  if (plugin.ok()) return VdbPlugin{reinterpret_cast<LdcVdbWriteFn>(plugin.value().symbols[0])};
   return Status(ErrorCode::kUnsupported, std::string("a .vdb output needs the OpenVDB plugin " LDC_VDB_PLUGIN_FILE
                                                      ", which did not load (tried ") +
-                                             tried + "). Write .json or .raw instead: they need no OpenVDB");
+                                             plugin.status().message() +
+                                             "). Write .json or .raw instead: they need no OpenVDB");
 }
 
 // Loaded once, on the first .vdb output.

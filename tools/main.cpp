@@ -7,6 +7,8 @@
 #include <iostream>
 #include <new>
 #include <sstream>
+#include <string>
+#include <string_view>
 
 #include "common.h"
 #include "ldc/io.h"
@@ -25,15 +27,26 @@ int parse_error_exit(const CLI::App& app, const CLI::ParseError& e) {
   return 1;
 }
 
+std::string version_text() {
+  return std::string("ldc ") + LDC_VERSION_STRING + " (.ldc format version " +
+         std::to_string(ldc::kLdcFormatVersion) + ")";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  // `ldc --version` alone answers before the command line is built: the
+  // options of every command (needed for --help and parsing) cost about as
+  // much as the rest of the tool's start-up (issue 22). The same output.
+  if (argc == 2 && std::string_view(argv[1]) == "--version") {
+    const bool written = std::printf("%s\n", version_text().c_str()) >= 0 && std::fflush(stdout) == 0;
+    return written ? ldc::tool::kExitSuccess : 1;
+  }
   CLI::App app{"ldc: Layered Depth Cube geometry kernel (format version " +
                std::to_string(ldc::kLdcFormatVersion) + ")"};
   app.require_subcommand(1);
   app.fallthrough();  // global flags may follow the subcommand
-  app.set_version_flag("--version", std::string("ldc ") + LDC_VERSION_STRING + " (.ldc format version " +
-                                        std::to_string(ldc::kLdcFormatVersion) + ")");
+  app.set_version_flag("--version", version_text());
   ldc::tool::CommonOptions common;
   app.add_flag("--json", common.json, "Machine-readable JSON on stdout");
   app.add_flag("-q,--quiet", common.quiet, "No progress bar");

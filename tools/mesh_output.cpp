@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "meshio/meshio.h"
+#include "plugin.h"
 
 namespace ldc::tool {
 namespace {
@@ -170,6 +171,9 @@ void add_grid_options(CLI::App* cmd, GridConfig& grid, const std::string& cells_
 Status check_mesh_output(const MeshOutputArgs& args) {
   Result<MeshFormat> format = mesh_format_from_path(args.output);
   if (!format.ok()) return format.status();
+  if (format.value() == MeshFormat::kDraco) {  // the plugin, before the work (issue 22)
+    if (Status s = check_draco_plugin(args.output); !s.ok()) return s;
+  }
   if (!(args.max_error_cells >= 0.0 && std::isfinite(args.max_error_cells)))
     return Status(ErrorCode::kInvalidArgument,
                   "--max-error " + std::to_string(args.max_error_cells) + ": must be a finite number of cells >= 0");

@@ -2,7 +2,8 @@
 # headers include nothing from CGAL, OpenVDB, Embree, a detail/ folder or internal/
 # folders, then configures, builds and runs tests/install/consumer against
 # the package with find_package(ldc), and runs the installed tool (its .vdb
-# export through the OpenVDB plugin). Run by ctest (label install):
+# export through the OpenVDB plugin, .drc files through the Draco plugin and
+# ldc gi through the GI plugins: issue 22). Run by ctest (label install):
 #   cmake -DBUILD_DIR=... -DCONSUMER_DIR=... -DWORK_DIR=... -P run_install_test.cmake
 cmake_policy(VERSION 3.20)
 foreach(var BUILD_DIR CONSUMER_DIR WORK_DIR)
@@ -107,8 +108,8 @@ function(run_tool out_var)
   set(${out_var} "${err}" PARENT_SCOPE)
 endfunction()
 run_tool(loader --version)
-if(NOT loader MATCHES "initialize program: " OR loader MATCHES "libopenvdb")
-  message(FATAL_ERROR "${tool} --version maps libopenvdb (or LD_DEBUG was ignored):\n${loader}")
+if(NOT loader MATCHES "initialize program: " OR loader MATCHES "libopenvdb|libembree|libvulkan|libdraco")
+  message(FATAL_ERROR "${tool} --version maps libopenvdb, libembree3, libvulkan or libdraco (or LD_DEBUG was ignored):\n${loader}")
 endif()
 set(tool_dir ${WORK_DIR}/tool)
 file(MAKE_DIRECTORY ${tool_dir})
@@ -122,3 +123,30 @@ if(NOT loader MATCHES "calling init: ${prefix_regex}/[^\n]*/ldc/ldc-vdb\\.so\n")
   message(FATAL_ERROR "the installed tool did not load its plugin from ${prefix}:\n${loader}")
 endif()
 message("the installed tool maps no OpenVDB at start-up and writes .vdb through ${prefix}/.../ldc/ldc-vdb.so")
+
+# The other plugins (issue 22), each loaded from the prefix by what needs it: a .drc output
+# (ldc-draco.so), ldc gi's Vulkan engine (ldc-gi-vulkan.so; without a Vulkan device the engine
+# falls back to the CPU, but the plugin is still loaded) and --reference (ldc-gi-reference.so).
+function(check_plugin loader plugin what)
+  if(NOT loader MATCHES "calling init: ${prefix_regex}/[^\n]*/ldc/${plugin}\\.so\n")
+    message(FATAL_ERROR "the installed tool did not load ${plugin}.so from ${prefix} for ${what}:\n${loader}")
+  endif()
+endfunction()
+run_tool(loader -q contour ${tool_dir}/world.ldc -o ${tool_dir}/world.drc)
+check_plugin("${loader}" ldc-draco "a .drc output")
+run_tool(loader -q info ${tool_dir}/world.ldc)
+if(loader MATCHES "libdraco|libembree|libvulkan")
+  message(FATAL_ERROR "the installed tool's info maps libdraco, libembree3 or libvulkan:\n${loader}")
+endif()
+file(GLOB_RECURSE gi_vulkan_plugin ${prefix}/ldc-gi-vulkan.so)
+if(gi_vulkan_plugin)
+  run_tool(loader -q gi ${tool_dir}/world.ldc -o ${tool_dir}/gi.png --width 16 --height 9 --levels 2 --resolution 16)
+  check_plugin("${loader}" ldc-gi-vulkan "ldc gi --engine vulkan")
+endif()
+file(GLOB_RECURSE gi_reference_plugin ${prefix}/ldc-gi-reference.so)
+if(gi_reference_plugin)
+  run_tool(loader -q gi ${tool_dir}/world.ldc -o ${tool_dir}/gi_ref.png --engine cpu --width 16 --height 9 --levels 2
+           --resolution 16 --reference --samples 2)
+  check_plugin("${loader}" ldc-gi-reference "ldc gi --reference")
+endif()
+message("the installed tool maps no Draco, Vulkan or Embree at start-up and loads their plugins from ${prefix}/.../ldc")
