@@ -16,19 +16,7 @@
 namespace ldc {
 namespace {
 
-// Chunk coordinates inside a checked source box are within +-2^17 (C >= 8,
-// nodes within +-2^20), so 21 bits per axis with a bias of 2^20 hold them.
-uint64_t chunk_key(const glm::ivec3& c) {
-  constexpr int64_t kBias = int64_t{1} << 20;
-  return uint64_t(c.x + kBias) | uint64_t(c.y + kBias) << 21 | uint64_t(c.z + kBias) << 42;
-}
 
-// snprintf: GCC 12 warns (-Wrestrict, a false positive) on "(" + std::to_string(...).
-std::string chunk_text(const glm::ivec3& c) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof(buffer), "(%d, %d, %d)", c.x, c.y, c.z);
-  return buffer;
-}
 
 size_t entry_bytes(const StoredChunk& data) {
   return kPagingEntryBytes + (data.data ? data.data->memory_bytes() : 0);
@@ -61,16 +49,16 @@ Result<World> PagedWorld::window(const glm::ivec3& chunk_lo, const glm::ivec3& c
   const glm::ivec3 hi = glm::min(chunk_hi, box.chunk_origin + box.chunk_dims);
   if (glm::any(glm::lessThanEqual(hi, lo))) {
     return Status(ErrorCode::kInvalidArgument,
-                  "paged world: window " + chunk_text(chunk_lo) + " .. " + chunk_text(chunk_hi) +
-                      " misses the source's box " + chunk_text(box.chunk_origin) + " .. " +
-                      chunk_text(box.chunk_origin + box.chunk_dims));
+                  "paged world: window " + detail::chunk_text(chunk_lo) + " .. " + detail::chunk_text(chunk_hi) +
+                      " misses the source's box " + detail::chunk_text(box.chunk_origin) + " .. " +
+                      detail::chunk_text(box.chunk_origin + box.chunk_dims));
   }
   std::lock_guard lock(mutex_);
   try {
     return make_window(lo, hi, ctx);
   } catch (const std::bad_alloc&) {
     return Status(ErrorCode::kTooLarge, "paged world: out of memory paging the window " +
-                                            chunk_text(lo) + " .. " + chunk_text(hi));
+                                            detail::chunk_text(lo) + " .. " + detail::chunk_text(hi));
   }
 }
 
@@ -123,7 +111,7 @@ Result<World> PagedWorld::make_window(const glm::ivec3& lo, const glm::ivec3& hi
 std::vector<glm::ivec3> PagedWorld::use_cached(const World& world) {
   std::vector<glm::ivec3> missing;
   for_each_slot(world, [&](const glm::ivec3& chunk) {
-    const uint64_t key = chunk_key(chunk);
+    const uint64_t key = detail::source_chunk_key(chunk);
     auto it = cache_.find(key);
     if (it == cache_.end()) {
       missing.push_back(chunk);
@@ -166,7 +154,7 @@ Status PagedWorld::cache_read(const std::vector<glm::ivec3>& chunks, std::vector
       if (first_error.ok()) first_error = read[i].status();
       continue;
     }
-    if (cache_.count(chunk_key(chunks[i])) != 0) continue;
+    if (cache_.count(detail::source_chunk_key(chunks[i])) != 0) continue;
     insert(chunks[i], std::move(read[i]).value(), false);
     ++stats_.page_ins;
   }
@@ -181,8 +169,8 @@ Status PagedWorld::prefetch(const glm::ivec3& chunk_lo, const glm::ivec3& chunk_
   if (glm::any(glm::lessThanEqual(hi, lo))) return {};
   const glm::i64vec3 dims = glm::i64vec3(hi - lo);
   if (dims.x * dims.y * dims.z > kMaxChunkSlots) {
-    return {ErrorCode::kTooLarge, "paged world: prefetch of " + chunk_text(lo) + " .. " + chunk_text(hi) +
-                                      " is larger than a window may be"};
+    return {ErrorCode::kTooLarge, "paged world: prefetch of " + detail::chunk_text(lo) + " .. " +
+                                      detail::chunk_text(hi) + " is larger than a window may be"};
   }
   std::vector<glm::ivec3> missing;
   {
@@ -190,7 +178,7 @@ Status PagedWorld::prefetch(const glm::ivec3& chunk_lo, const glm::ivec3& chunk_
     for (int z = lo.z; z < hi.z; ++z)
       for (int y = lo.y; y < hi.y; ++y)
         for (int x = lo.x; x < hi.x; ++x)
-          if (cache_.count(chunk_key({x, y, z})) == 0) missing.emplace_back(x, y, z);
+          if (cache_.count(detail::source_chunk_key({x, y, z})) == 0) missing.emplace_back(x, y, z);
   }
   std::vector<Result<StoredChunk>> read = read_chunks(missing, ctx);
   std::lock_guard lock(mutex_);
@@ -205,7 +193,7 @@ Status PagedWorld::prefetch(const glm::ivec3& chunk_lo, const glm::ivec3& chunk_
 void PagedWorld::fill(World& world) {
   size_t bytes = 0;
   for_each_slot(world, [&](const glm::ivec3& chunk) {
-    const Entry& e = cache_.at(chunk_key(chunk));
+    const Entry& e = cache_.at(detail::source_chunk_key(chunk));
     bytes += e.bytes;
     if (e.data.kind == ChunkKind::kMixed) {
       world.set_chunk(chunk, e.data.data);
@@ -217,7 +205,7 @@ void PagedWorld::fill(World& world) {
 }
 
 void PagedWorld::insert(const glm::ivec3& chunk, StoredChunk data, bool dirty) {
-  const uint64_t key = chunk_key(chunk);
+  const uint64_t key = detail::source_chunk_key(chunk);
   auto [it, fresh] = cache_.try_emplace(key);
   Entry& e = it->second;
   if (!fresh) {  // replaced: take the old entry out of the counts
@@ -272,12 +260,12 @@ Status PagedWorld::check_put(const World& edited, std::span<const glm::ivec3> ch
   }
   for (const glm::ivec3& c : chunks) {
     if (!edited.contains_chunk(c)) {
-      return {ErrorCode::kInvalidArgument, "paged world: put: chunk " + chunk_text(c) +
+      return {ErrorCode::kInvalidArgument, "paged world: put: chunk " + detail::chunk_text(c) +
                                                " is outside the edited world's box"};
     }
     if (!lay.box.contains(c)) {
       return {ErrorCode::kInvalidArgument,
-              "paged world: put: chunk " + chunk_text(c) + " is outside the source's box"};
+              "paged world: put: chunk " + detail::chunk_text(c) + " is outside the source's box"};
     }
   }
   return {};

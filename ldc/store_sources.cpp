@@ -91,18 +91,7 @@ StoredChunk stored(Chunk&& chunk) {
   return {ChunkKind::kMixed, std::make_shared<const Chunk>(std::move(chunk))};
 }
 
-uint64_t overlay_key(const glm::ivec3& c) {
-  // Chunk coordinates of a checked layout are within +-2^17 (C >= 8).
-  constexpr int64_t kBias = int64_t{1} << 20;
-  return uint64_t(c.x + kBias) | uint64_t(c.y + kBias) << 21 | uint64_t(c.z + kBias) << 42;
-}
 
-// snprintf: GCC 12 warns (-Wrestrict, a false positive) on "(" + std::to_string(...).
-std::string chunk_text(const glm::ivec3& c) {
-  char buffer[48];
-  std::snprintf(buffer, sizeof(buffer), "(%d, %d, %d)", c.x, c.y, c.z);
-  return buffer;
-}
 
 }  // namespace
 
@@ -160,7 +149,7 @@ Result<StoredChunk> ImplicitSource::read(const glm::ivec3& chunk) const {
   try {
     return stored(build_implicit_chunk(*solid_, bounds_, layout_.lattice, layout_.chunk_size, chunk));
   } catch (const std::bad_alloc&) {
-    return Status(ErrorCode::kTooLarge, "source: out of memory building chunk " + chunk_text(chunk));
+    return Status(ErrorCode::kTooLarge, "source: out of memory building chunk " + detail::chunk_text(chunk));
   }
 }
 
@@ -182,7 +171,7 @@ OverlaySource::OverlaySource(std::shared_ptr<const ChunkSource> base, ChunkFinde
 Result<StoredChunk> OverlaySource::read(const glm::ivec3& chunk) const {
   {
     std::shared_lock lock(mutex_);
-    auto it = chunks_.find(overlay_key(chunk));
+    auto it = chunks_.find(detail::source_chunk_key(chunk));
     if (it != chunks_.end()) return it->second;
   }
   if (lower_ && layout().box.contains(chunk)) {
@@ -194,7 +183,7 @@ Result<StoredChunk> OverlaySource::read(const glm::ivec3& chunk) const {
 }
 
 Status OverlaySource::set(const glm::ivec3& chunk, StoredChunk data) {
-  const std::string where = "overlay: chunk " + chunk_text(chunk);
+  const std::string where = "overlay: chunk " + detail::chunk_text(chunk);
   if (!layout().box.contains(chunk)) {
     return {ErrorCode::kInvalidArgument, where + " is outside the source's box"};
   }
@@ -212,7 +201,7 @@ Status OverlaySource::set(const glm::ivec3& chunk, StoredChunk data) {
     }
   }
   std::unique_lock lock(mutex_);
-  chunks_[overlay_key(chunk)] = std::move(data);
+  chunks_[detail::source_chunk_key(chunk)] = std::move(data);
   return {};
 }
 
