@@ -166,10 +166,12 @@ void add_build_command(CLI::App& app, CommonOptions& common) {
   CLI::App* cmd = app.add_subcommand("build", "Build an LDC from a mesh, primitive, heightfield or the landscape");
   cmd->add_option("input", args->input, "Mesh file (.obj .ply .stl .off)");
   cmd->add_option("-o,--output", args->output, "Output .ldc file")->required();
-  cmd->add_option("--cells", args->grid.cells, "Cells along the longest axis of the input")->capture_default_str();
+  CLI::Option* cells =
+      cmd->add_option("--cells", args->grid.cells, "Cells along the longest axis of the input")->capture_default_str();
   cmd->add_option("--cell-size", args->grid.cell_size, "Cell size h (m); overrides --cells");
   cmd->add_option("--chunk-size,--chunk", args->grid.chunk_size, "Chunk size in cells: 8, 16, 32 or 64")->capture_default_str();
-  cmd->add_option("--padding", args->grid.padding, "Empty cells around the input")->capture_default_str();
+  CLI::Option* padding =
+      cmd->add_option("--padding", args->grid.padding, "Empty cells around the input")->capture_default_str();
   add_mesh_reading_options(cmd, args->reading, "solid");
   add_up_option(cmd, args->up, "y for a mesh (the Recast convention); sets which side of a shell is its floor");
   cmd->add_option("--primitive", args->primitive, "sphere | box | capsule | cylinder");
@@ -189,7 +191,14 @@ void add_build_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--seed", args->seed, "Landscape seed")->capture_default_str();
   cmd->add_option("--size", args->size, "Landscape size X,Y (m)")->capture_default_str();
   cmd->add_flag("--validate", args->validate, "Validate the result before writing it (exit 2 and no file if invalid)");
-  cmd->callback([args, &common] {
+  cmd->callback([args, &common, cells, padding] {
+    // The landscape's extent is --size and its cells --cell-size: say so
+    // rather than ignore the options meant for meshes and primitives.
+    if (args->terrain && (cells->count() > 0 || padding->count() > 0)) {
+      throw CLI::RuntimeError(fail("build", std::string(cells->count() > 0 ? "--cells" : "--padding") +
+                                                " does not apply to --terrain (its extent is --size X,Y and its "
+                                                "cell size --cell-size)"));
+    }
     int code = run_build(*args, common);
     if (code != 0) throw CLI::RuntimeError(code);
   });

@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
   ldc::tool::CommonOptions common;
   app.add_flag("--json", common.json, "Machine-readable JSON on stdout");
   app.add_flag("-q,--quiet", common.quiet, "No progress bar");
-  app.add_option("--threads", common.threads, "Worker threads (0 = all cores)");
+  app.add_option("--threads", common.threads, "Worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
   app.add_flag("--strict", common.strict,
                "Exit 3 when the command printed a warning (its output is still written)");
   app.footer(ldc::tool::kExitStatusHelp);
