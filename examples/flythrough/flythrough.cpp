@@ -18,9 +18,11 @@
 //              or were edited (contour_chunk), nearest first; the frame
 //              collects what it finished and drops meshes of chunks that
 //              left the window;
-//   5. ray     a ground ray is cast under the camera (Queries).
-// Not done here yet: LOD meshes (every chunk is meshed at full resolution)
-// and nav updates around the player.
+//   5. ray     a ground ray is cast under the camera (Queries);
+//   6. nav     a nav worker thread rebuilds the nav mesh of the window
+//              around the player when it has moved 8 m or dug, and plans a
+//              path 12 m ahead on it.
+// Not done here yet: LOD meshes (every chunk is meshed at full resolution).
 // It prints the median, p95 and max of each stage and of the frame, the
 // peak resident memory, the pager's and the log's figures, and with --png
 // renders a few frames (render/render.h).
@@ -37,6 +39,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -51,6 +54,7 @@
 #include "ldc/query.h"
 #include "ldc/store.h"
 #include "ldc/terrain.h"
+#include "nav/nav.h"
 #include "render/render.h"
 
 namespace {
@@ -115,11 +119,13 @@ bool parse_options(int argc, char** argv, Options* o) {
 
 constexpr int kFps = 60;
 constexpr double kViewRadius = 40.0;  // m: the window around the camera
+constexpr double kNavRadius = 20.0;   // m: the window the nav mesh covers
+constexpr double kNavRebuildDistance = 8.0;  // m
 
 // One frame's measurements [ms].
 struct Frame {
-  double page = 0, edit = 0, save = 0, mesh = 0, ray = 0;
-  double total() const { return page + edit + save + mesh + ray; }
+  double page = 0, edit = 0, save = 0, mesh = 0, ray = 0, nav = 0;
+  double total() const { return page + edit + save + mesh + ray + nav; }
 };
 
 // The camera's ground track: a straight line across the world from near its
@@ -130,11 +136,15 @@ glm::dvec2 track(const ldc::SourceLayout& layout, double size_m, double t_second
   return start + dir * (speed * t_seconds);
 }
 
-// Prefetches on its own thread the box a second ahead of the camera.
-class Prefetcher {
+// Runs `work` on its own thread for the newest job posted to it: a job not
+// yet started when a newer one comes is dropped (only the newest window
+// matters), as for a game's background paging or nav rebuild.
+template <class Job>
+class LatestJobWorker {
  public:
-  explicit Prefetcher(ldc::PagedWorld& paged) : paged_(paged), thread_([this] { loop(); }) {}
-  ~Prefetcher() {
+  explicit LatestJobWorker(std::function<void(const Job&)> work)
+      : work_(std::move(work)), thread_([this] { loop(); }) {}
+  ~LatestJobWorker() {
     {
       std::lock_guard lock(mutex_);
       stop_ = true;
@@ -142,12 +152,10 @@ class Prefetcher {
     wake_.notify_one();
     thread_.join();
   }
-  void want(const glm::ivec3& lo, const glm::ivec3& hi) {
+  void post(Job job) {
     {
       std::lock_guard lock(mutex_);
-      lo_ = lo;
-      hi_ = hi;
-      pending_ = true;
+      job_ = std::move(job);
     }
     wake_.notify_one();
   }
@@ -156,23 +164,82 @@ class Prefetcher {
   void loop() {
     std::unique_lock lock(mutex_);
     while (true) {
-      wake_.wait(lock, [this] { return stop_ || pending_; });
+      wake_.wait(lock, [this] { return stop_ || job_.has_value(); });
       if (stop_) return;
-      const glm::ivec3 lo = lo_, hi = hi_;
-      pending_ = false;
+      const Job job = std::move(*job_);
+      job_.reset();
       lock.unlock();
-      const Status s = paged_.prefetch(lo, hi);
-      if (!s.ok()) std::fprintf(stderr, "prefetch: %s\n", s.to_string().c_str());
+      work_(job);
       lock.lock();
     }
   }
 
-  ldc::PagedWorld& paged_;
+  std::function<void(const Job&)> work_;
   std::mutex mutex_;
   std::condition_variable wake_;
-  glm::ivec3 lo_{0}, hi_{0};
-  bool pending_ = false, stop_ = false;
+  std::optional<Job> job_;
+  bool stop_ = false;
   std::thread thread_;
+};
+
+struct ChunkBox {
+  glm::ivec3 lo{0}, hi{0};
+};
+
+// Prefetches on its own thread the box a second ahead of the camera.
+class Prefetcher {
+ public:
+  explicit Prefetcher(ldc::PagedWorld& paged)
+      : worker_([&paged](const ChunkBox& box) {
+          const Status s = paged.prefetch(box.lo, box.hi);
+          if (!s.ok()) std::fprintf(stderr, "prefetch: %s\n", s.to_string().c_str());
+        }) {}
+  void want(const glm::ivec3& lo, const glm::ivec3& hi) { worker_.post({lo, hi}); }
+
+ private:
+  LatestJobWorker<ChunkBox> worker_;
+};
+
+// Nav around the player, on its own thread: a nav mesh of the window around
+// the player (rebuilt when the player has moved kNavRebuildDistance or dug)
+// and a path from the player to a point ahead of it on that mesh.
+struct NavJob {
+  std::shared_ptr<const ldc::World> window;
+  glm::dvec3 from{0.0}, to{0.0};
+};
+struct NavResults {
+  std::mutex mutex;
+  std::vector<double> build_ms;
+  size_t paths = 0, complete = 0;
+  double path_length = 0.0;
+};
+
+class NavWorker {
+ public:
+  explicit NavWorker(NavResults& results) : worker_([&results](const NavJob& job) { run(job, results); }) {}
+  void post(NavJob job) { worker_.post(std::move(job)); }
+
+ private:
+  static void run(const NavJob& job, NavResults& results) {
+    const Clock::time_point start = Clock::now();
+    Result<ldc::NavMesh> nav = ldc::NavMesh::build(*job.window, ldc::NavConfig{});
+    const double ms = ms_since(start);
+    if (!nav.ok()) {
+      std::fprintf(stderr, "nav: %s\n", nav.status().to_string().c_str());
+      return;
+    }
+    ldc::NavQuery query(nav.value());
+    Result<ldc::NavPath> path = query.find_path(job.from, job.to);
+    std::lock_guard lock(results.mutex);
+    results.build_ms.push_back(ms);
+    ++results.paths;
+    if (path.ok() && path->status == ldc::PathStatus::kComplete) {
+      ++results.complete;
+      results.path_length += path->length;
+    }
+  }
+
+  LatestJobWorker<NavJob> worker_;
 };
 
 // Meshes chunks on its own thread, as an engine's job system would: the
@@ -262,6 +329,7 @@ struct Session {
   std::vector<glm::ivec3> remesh;  // chunks to (re)mesh, nearest first
   size_t triangles = 0, meshed = 0, digs = 0, saved_chunks = 0;
   std::optional<double> ground_z;
+  std::optional<glm::dvec2> nav_centre;  // where the nav worker's last window is centred
 };
 
 std::tuple<int, int, int> key(const glm::ivec3& c) { return {c.x, c.y, c.z}; }
@@ -356,11 +424,57 @@ void mesh(Session& s, MeshWorker& worker, const glm::dvec2& xy, bool window_chan
   for (const auto& [k, m] : s.meshes) s.triangles += m.mesh.triangle_count();
 }
 
+// The ground under (x, y): a ray cast straight down through the window.
+std::optional<double> ground_at(const ldc::Queries& q, const ldc::World& window, const glm::dvec2& xy) {
+  Result<ldc::RayHit> hit = q.ray_cast({{xy.x, xy.y, window.box().max.z + 1.0}, {0.0, 0.0, -1.0}});
+  return hit.ok() && hit->hit ? std::optional<double>(hit->point.z) : std::nullopt;
+}
+
 void ground_ray(Session& s, const glm::dvec2& xy) {
   ldc::Queries q(s.window);
-  const ldc::WorldBox box = s.window.box();
-  Result<ldc::RayHit> hit = q.ray_cast({{xy.x, xy.y, box.max.z + 1.0}, {0.0, 0.0, -1.0}});
-  s.ground_z = hit.ok() && hit->hit ? std::optional<double>(hit->point.z) : std::nullopt;
+  s.ground_z = ground_at(q, s.window, xy);
+}
+
+// The chunks of `window` within [lo, hi) as a World of their own (shared,
+// not copied): what the nav worker builds on.
+Result<ldc::World> sub_window(const ldc::World& window, glm::ivec3 lo, glm::ivec3 hi) {
+  lo = glm::max(lo, window.chunk_origin());
+  hi = glm::min(hi, window.chunk_origin() + window.chunk_dims());
+  ldc::WorldConfig config = window.config();
+  config.chunk_origin = lo;
+  config.chunk_dims = hi - lo;
+  Result<ldc::World> made = ldc::World::create(config);
+  if (!made.ok()) return made.status();
+  for (int z = lo.z; z < hi.z; ++z)
+    for (int y = lo.y; y < hi.y; ++y)
+      for (int x = lo.x; x < hi.x; ++x) {
+        const glm::ivec3 c(x, y, z);
+        if (window.chunk_kind(c) == ldc::ChunkKind::kMixed) {
+          made->set_chunk(c, window.chunk_shared(c));
+        } else if (window.chunk_kind(c) == ldc::ChunkKind::kSolid) {
+          made->set_uniform_chunk(c, true);
+        }
+      }
+  return made;
+}
+
+// Hands the nav worker the window around the player when the player has
+// moved far enough since the last one, or dug: it rebuilds the nav mesh
+// there and plans a path 12 m ahead.
+void nav(Session& s, NavWorker& worker, const glm::dvec2& xy, const glm::dvec2& dir, bool dug) {
+  if (!s.ground_z) return;
+  if (!dug && s.nav_centre && glm::length(*s.nav_centre - xy) < kNavRebuildDistance) return;
+  glm::ivec3 lo, hi;
+  chunk_box(s.paged->layout(), xy, kNavRadius, &lo, &hi);
+  Result<ldc::World> w = sub_window(s.window, lo, hi);
+  if (!w.ok()) return;
+  ldc::Queries q(s.window);
+  const glm::dvec2 goal = xy + 12.0 * dir;
+  const std::optional<double> goal_z = ground_at(q, s.window, goal);
+  if (!goal_z) return;
+  worker.post({std::make_shared<const ldc::World>(std::move(w).value()), glm::dvec3(xy, *s.ground_z),
+               glm::dvec3(goal, *goal_z)});
+  s.nav_centre = xy;
 }
 
 bool render_frame(const Session& s, const Options& o, int frame, const glm::dvec2& xy, const glm::dvec2& dir) {
@@ -397,7 +511,7 @@ void print_summary(const std::vector<Frame>& frames) {
   std::printf("| stage | median ms | p95 ms | max ms |\n|---|---|---|---|\n");
   const std::pair<const char*, double Frame::*> stages[] = {
       {"page", &Frame::page}, {"edit", &Frame::edit}, {"save", &Frame::save}, {"mesh", &Frame::mesh},
-      {"ray", &Frame::ray}};
+      {"ray", &Frame::ray}, {"nav", &Frame::nav}};
   for (const auto& [name, field] : stages) {
     std::vector<double> v;
     for (const Frame& f : frames) v.push_back(f.*field);
@@ -449,9 +563,11 @@ int main(int argc, char** argv) {
   std::vector<Frame> frames;
   const int render_every = std::max(1, o.frames / 3);
   double setup_ms = 0.0, worker_ms = 0.0;
+  NavResults nav_results;
   {
     Prefetcher prefetcher(*s.paged);
     MeshWorker worker(contour);
+    NavWorker nav_worker(nav_results);
     // The first window and its meshes: what a game does behind its loading screen.
     Clock::time_point start = Clock::now();
     bool changed = false;
@@ -492,6 +608,9 @@ int main(int argc, char** argv) {
       start = Clock::now();
       if (st.ok()) ground_ray(s, xy);
       f.ray = ms_since(start);
+      start = Clock::now();
+      if (st.ok()) nav(s, nav_worker, xy, glm::normalize(ahead - xy), f.edit > 0.0);
+      f.nav = ms_since(start);
       if (!st.ok()) return std::fprintf(stderr, "frame %d: %s\n", i, st.to_string().c_str()), 1;
       frames.push_back(f);
       if (!o.quiet && (i % kFps == 0)) {
@@ -519,6 +638,14 @@ int main(int argc, char** argv) {
               "(%zu triangles), %zu waiting\n",
               s.meshed, worker_ms, s.meshed ? worker_ms / double(s.meshed) : 0.0, s.meshes.size(), s.triangles,
               s.remesh.size());
+  {
+    std::lock_guard lock(nav_results.mutex);
+    const std::vector<double>& b = nav_results.build_ms;
+    std::printf("nav: %zu nav meshes built on the nav worker around the player (median %.0f ms, max %.0f ms), %zu of "
+                "%zu paths 12 m ahead complete\n",
+                b.size(), b.empty() ? 0.0 : percentile(b, 0.5), b.empty() ? 0.0 : percentile(b, 1.0),
+                nav_results.complete, nav_results.paths);
+  }
   std::printf("peak resident memory %.0f MB (setup %.0f ms, not in the frame figures)\n", peak_rss_mb(), setup_ms);
   return 0;
 }
