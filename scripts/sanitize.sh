@@ -9,7 +9,8 @@ jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build-asan -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DLDC_SANITIZE=ON \
   -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DCMAKE_C_FLAGS_RELWITHDEBINFO="-O1 -g1" \
   -DLDC_BUILD_TOOLS=ON -DLDC_BUILD_EXAMPLES=OFF -DLDC_INSTALL=OFF >/dev/null
-cmake --build build-asan -j "$jobs" --target ldc_tests ldc_capi_test ldc_tool make_levels ldc_vdb_stale_plugin
+cmake --build build-asan -j "$jobs" --target ldc_tests ldc_capi_test ldc_tool make_levels ldc_vdb_stale_plugin \
+  ldc_gi_vulkan_stale_plugin
 # The two longest property tests (10,000 random edits; every dirty box re-meshed
 # against a fresh build) take 140 of the 265 test seconds under ASan, and random
 # untangling and the GI set_lights check another 20; they run unsanitized in the
