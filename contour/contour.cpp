@@ -195,6 +195,7 @@ Result<ChunkedMesh> ChunkedMesh::create(const World& world, const ContourConfig&
 
 Status ChunkedMesh::build(const World& world, Context* ctx) {
   Status s = check_contour_config(config_);
+  if (s.ok()) s = check_box_faces_outside(world);
   if (!s.ok()) return s;
   ScopedTimer timer(ctx, "contour");
   ContourStats stats;
@@ -351,6 +352,7 @@ void ContourStats::add_counts(const ContourStats& s) {
 Result<ContourMesh> contour_world(const World& world, const ContourConfig& config, Context* ctx,
                                   ContourStats* stats) {
   Status s = check_contour_config(config);
+  if (s.ok()) s = check_box_faces_outside(world);
   if (!s.ok()) return s;
   try {
     ScopedTimer timer(ctx, "contour");

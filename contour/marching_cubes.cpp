@@ -93,6 +93,7 @@ int floor_div(int a, int b) { return a >= 0 ? a / b : -((-a + b - 1) / b); }
 }  // namespace
 
 Result<ContourMesh> marching_cubes(const World& world, Context* ctx) {
+  if (Status s = check_box_faces_outside(world); !s.ok()) return s;
   const int c = world.chunk_size();
   std::vector<glm::ivec3> chunks;
   const glm::ivec3 lo = world.chunk_origin() - 1, hi = world.chunk_origin() + world.chunk_dims();

@@ -14,6 +14,7 @@
 
 #include "ldc/internal/ray_math.h"
 #include "ldc/internal/validate_work.h"
+#include "ldc/internal/vec_text.h"
 #include "ldc/world.h"
 
 namespace ldc {
@@ -284,6 +285,50 @@ ValidationReport validate_with_progress(const World& world, const ValidateOption
 }
 
 }  // namespace detail
+
+namespace {
+
+Status face_inside(const glm::ivec3& chunk, int axis, bool high, int ray) {
+  std::string where = std::string("chunk ") + detail::chunk_text(chunk) + ", " + axis_name(axis) + " rays";
+  if (ray >= 0) where += " (ray " + std::to_string(ray) + ")";
+  return {ErrorCode::kInvalidArgument,
+          where + (high ? " end" : " start") + " inside at the world box face (" + (high ? "high" : "low") +
+              " " + axis_name(axis) +
+              "): the solid is cut open there, as in a paged window cut through the ground; intersect it with a "
+              "box inside the window first"};
+}
+
+// The rays of one chunk on a box face: inside at that face?
+Status check_face_chunk(const World& w, const glm::ivec3& ch, int a, bool high) {
+  const ChunkKind kind = w.chunk_kind(ch);
+  if (kind == ChunkKind::kEmpty) return {};
+  if (kind == ChunkKind::kSolid) return face_inside(ch, a, high, -1);
+  const RayFamily& f = w.chunk(ch)->axis[size_t(a)];
+  if (f.is_uniform()) return f.uniform_inside() ? face_inside(ch, a, high, -1) : Status{};
+  const int rays = w.chunk_size() * w.chunk_size();
+  for (int r = 0; r < rays; ++r) {
+    const bool ends_flipped = high && f.point_count(r) % 2 == 1;
+    if (f.starts_inside(r) != ends_flipped) return face_inside(ch, a, high, r);
+  }
+  return {};
+}
+
+}  // namespace
+
+Status check_box_faces_outside(const World& w) {
+  const glm::ivec3 lo = w.chunk_origin(), hi = lo + w.chunk_dims();
+  for (int a = 0; a < 3; ++a) {
+    const int u = axis_u(a), v = axis_v(a);
+    for (const bool high : {false, true}) {
+      glm::ivec3 ch;
+      ch[a] = high ? hi[a] - 1 : lo[a];
+      for (ch[v] = lo[v]; ch[v] < hi[v]; ++ch[v])
+        for (ch[u] = lo[u]; ch[u] < hi[u]; ++ch[u])
+          if (Status s = check_face_chunk(w, ch, a, high); !s.ok()) return s;
+    }
+  }
+  return {};
+}
 
 Status validate_chunk(const Chunk& chunk, int chunk_size, bool check_cross_axis) {
   ErrorSink sink(1);

@@ -17,6 +17,7 @@
 
 #include <tbb/global_control.h>
 
+#include "contour/contour.h"
 #include "csg/csg.h"
 #include "ldc/store.h"
 #include "ldc/terrain.h"
@@ -608,6 +609,27 @@ TEST(Store, SavedEditsComeBackWhenTheStoreIsReopened) {
   EXPECT_NE(refused.status().message().find("differ from those of its base description"), std::string::npos);
   std::remove(path.c_str());
   std::remove(wrong.c_str());
+}
+
+// A window cut through the ground is not a closed solid: meshing it whole is
+// refused naming the face (it crashed inside meshoptimizer and marching
+// cubes); the whole-box window and an ordinary world pass the check.
+TEST(Store, MeshingAWindowCutThroughTheGroundIsRefused) {
+  PagedWorld paged(small_source());
+  const SourceBox box = paged.layout().box;
+  Result<World> part = paged.window(box.chunk_origin, box.chunk_origin + glm::ivec3(2, 2, box.chunk_dims.z));
+  ASSERT_TRUE(part.ok());
+  const Status faces = check_box_faces_outside(*part);
+  ASSERT_EQ(faces.code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(faces.message().find("inside at the world box face"), std::string::npos) << faces.message();
+  EXPECT_EQ(contour_world(*part).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(marching_cubes(*part).status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(ChunkedMesh::create(*part).status().code(), ErrorCode::kInvalidArgument);
+  Result<World> all = paged.window(box.chunk_origin, box_end(box));
+  ASSERT_TRUE(all.ok());
+  EXPECT_TRUE(check_box_faces_outside(*all).ok());
+  EXPECT_TRUE(check_box_faces_outside(whole_world()).ok());
+  EXPECT_TRUE(contour_world(*all).ok());
 }
 
 }  // namespace
