@@ -1,7 +1,9 @@
-// ldc contour (world -> mesh) and ldc remesh (mesh -> LDC -> mesh).
+// ldc contour (world or a region of a .ldcs store -> mesh) and ldc remesh (mesh -> LDC -> mesh).
 #include <memory>
 
+#include "cmd_store.h"
 #include "common.h"
+#include "csg/csg.h"
 #include "ldc/io.h"
 #include "mesh_output.h"
 #include "meshio/meshio.h"
@@ -13,12 +15,75 @@ struct ContourArgs {
   std::string input;
   MeshOutputArgs mesh;
   GridConfig grid;  // remesh only
+  std::string region;  // contour of a .ldcs store only: X0,Y0,Z0,X1,Y1,Z1 (m)
 };
+
+// Cuts the window's solid down to the region's box (an intersect edit), so
+// that it no longer reaches the window's faces, where contouring needs
+// nothing solid (a window cut through the ground has rays inside at its
+// sides): the mesh is then closed by caps on the region's faces. The cap
+// sits half a cell inside the region's chunks (off the lattice's nodes); a
+// face of the region on the store's own face needs no cap.
+Result<World> cut_to_region(World window, const SourceLayout& layout, const ChunkRange& region, Context* ctx) {
+  const double cs = layout.lattice.cell_size * layout.chunk_size, h = layout.lattice.cell_size;
+  const glm::ivec3 box_lo = layout.box.chunk_origin, box_hi = layout.box.chunk_origin + layout.box.chunk_dims;
+  glm::dvec3 min, max;
+  bool cut = false;
+  for (int a = 0; a < 3; ++a) {
+    const double lo = layout.lattice.origin[a] + region.lo[a] * cs, hi = layout.lattice.origin[a] + region.hi[a] * cs;
+    const bool cut_lo = region.lo[a] > box_lo[a], cut_hi = region.hi[a] < box_hi[a];
+    min[a] = cut_lo ? lo + 0.5 * h : lo - cs;  // no cap: beyond the store's face
+    max[a] = cut_hi ? hi - 0.5 * h : hi + cs;
+    cut = cut || cut_lo || cut_hi;
+  }
+  if (!cut) return window;  // the whole store: its faces hold no solid
+  WorldEditor editor(std::move(window));
+  Result<EditReceipt> r = editor.apply(Brush::box(0.5 * (min + max), 0.5 * (max - min)), EditOp::kIntersect, ctx);
+  if (!r.ok()) return Status(r.status().code(), "cutting the window to the region: " + r.status().message());
+  return editor.world();
+}
+
+// A region of a store: the chunks it meets and one chunk of margin are
+// paged in (the base generates those no commit holds), the solid is cut to
+// the region's chunks (cut_to_region) and contoured.
+int run_store_contour(const ContourArgs& a, const CommonOptions& common) {
+  if (a.region.empty()) {
+    return fail("contour", a.input + " is a .ldcs store: give --region X0,Y0,Z0,X1,Y1,Z1 (m), the part to contour");
+  }
+  Result<Store> store = open_store(a.input);
+  if (!store.ok()) return fail("contour", store.status());
+  const SourceLayout& layout = store->source->layout();
+  Result<ChunkRange> range = parse_region(layout, a.region);
+  if (!range.ok()) return fail("contour", range.status());
+  // Bounded, margin included, before anything is paged.
+  Result<ChunkRange> window = clip_chunks(layout, range.value(), 1, "--region '" + a.region + "' with its margin");
+  if (!window.ok()) return fail("contour", window.status());
+  ProgressBar bar(!common.quiet);
+  ScopedTimer t(nullptr, "");
+  PagedWorld paged(store->source);
+  Result<World> w = paged.window(window->lo, window->hi, bar.context());
+  if (!w.ok()) return fail("contour", w.status());
+  const double page = t.seconds();
+  ScopedTimer c(nullptr, "");
+  w = cut_to_region(std::move(w).value(), layout, range.value(), bar.context());
+  if (!w.ok()) return fail("contour", w.status());
+  bar.finish();
+  nlohmann::json report = {{"seconds", {{"page", page}, {"cut", c.seconds()}}},
+                           {"region", range_json(layout, range.value())},
+                           {"chunks_paged", paged.stats().page_ins}};
+  return contour_and_report("contour", w.value(), a.mesh, bar, std::move(report), common,
+                            [](const nlohmann::json& r) {
+                              std::printf("  region %s, %zu chunks paged\n", range_text(r["region"]).c_str(),
+                                          r["chunks_paged"].get<size_t>());
+                            });
+}
 
 int run_contour(const ContourArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
   Status out = check_mesh_output(a.mesh);
   if (!out.ok()) return fail("contour", out);
+  if (is_store_file(a.input)) return run_store_contour(a, common);
+  if (!a.region.empty()) return fail("contour", "--region is for .ldcs stores; " + a.input + " is not one");
   ProgressBar bar(!common.quiet);
   ScopedTimer t(nullptr, "");
   Result<World> w = load_world(a.input, {}, bar.context());
@@ -49,8 +114,11 @@ int run_remesh(const ContourArgs& a, const CommonOptions& common) {
 void add_contour_commands(CLI::App& app, CommonOptions& common) {
   auto c = std::make_shared<ContourArgs>();
   CLI::App* contour = app.add_subcommand("contour", "Dual-contour a .ldc world into a mesh, with the quality report");
-  contour->add_option("input", c->input, ".ldc file")->required();
+  contour->add_option("input", c->input, ".ldc file or .ldcs store (with --region)")->required();
   add_mesh_output_options(contour, c->mesh);
+  contour->add_option("--region", c->region,
+                      "A .ldcs store's box X0,Y0,Z0,X1,Y1,Z1 (m): the chunks it meets are paged in and contoured "
+                      "as a world of their own (closed at the box's faces)");
   contour->callback([c, &common] {
     int code = run_contour(*c, common);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -1,7 +1,11 @@
-// ldc edit: a world plus a JSON script of brush edits -> the edited world.
+// ldc edit: a world plus a JSON script of brush edits -> the edited world; a .ldcs store is edited in place.
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
+#include <variant>
 
+#include "cmd_store.h"
 #include "common.h"
 #include "contour/contour.h"
 #include "meshio/meshio.h"
@@ -112,7 +116,7 @@ Status validate_result(const World& world, nlohmann::json& report, Context* ctx)
                                     " errors" + first + "); nothing written"};
 }
 
-void print_edit_report(const nlohmann::json& report) {
+void print_edit_lines(const nlohmann::json& report) {
   for (const auto& e : report["edits"]) {
     std::printf("edit %zu: %s %s", e["index"].get<size_t>(), e["op"].get<std::string>().c_str(),
                 e["brush"].get<std::string>().c_str());
@@ -129,14 +133,179 @@ void print_edit_report(const nlohmann::json& report) {
     if (b.contains("remesh_ms")) std::printf(", re-mesh %.2f ms", b["remesh_ms"].get<double>());
     std::printf("\n");
   }
+}
+
+void print_edit_report(const nlohmann::json& report) {
+  print_edit_lines(report);
   if (report.contains("validation")) std::printf("%s", validation_text(report["validation"]).c_str());
   std::printf("wrote %s (version %llu)\n", report["output"].get<std::string>().c_str(),
               static_cast<unsigned long long>(report["version"].get<uint64_t>()));
   print_seconds(report["seconds"]);
 }
 
+// The box of a brush in world space (m), from its shape alone (nothing is
+// rasterized, so a huge brush is bounded before it costs memory): a
+// primitive's own bounds, a noise sphere's largest radius, a mesh's
+// transformed vertices.
+WorldBox brush_box(const Brush& brush) {
+  struct Visitor {
+    WorldBox operator()(const Primitive& p) const { return make_primitive_solid(p)->bounds(); }
+    WorldBox operator()(const NoiseShape& n) const {
+      return corners(glm::dvec3(n.noise.radius * (1.0 + n.noise.amplitude)), n.transform);
+    }
+    WorldBox operator()(const MeshShape& m) const {
+      WorldBox b{glm::dvec3(std::numeric_limits<double>::infinity()), glm::dvec3(-std::numeric_limits<double>::infinity())};
+      if (!m.mesh) return b;
+      for (const glm::dvec3& p : m.mesh->positions) {
+        const glm::dvec3 w = glm::dvec3(m.transform * glm::dvec4(p, 1.0));
+        b.min = glm::min(b.min, w);
+        b.max = glm::max(b.max, w);
+      }
+      return b;
+    }
+    // The local box [-half, half] under an affine transform.
+    static WorldBox corners(const glm::dvec3& half, const glm::dmat4& transform) {
+      WorldBox b{glm::dvec3(std::numeric_limits<double>::infinity()), glm::dvec3(-std::numeric_limits<double>::infinity())};
+      for (int i = 0; i < 8; ++i) {
+        const glm::dvec3 local((i & 1) ? half.x : -half.x, (i & 2) ? half.y : -half.y, (i & 4) ? half.z : -half.z);
+        const glm::dvec3 w = glm::dvec3(transform * glm::dvec4(local, 1.0));
+        b.min = glm::min(b.min, w);
+        b.max = glm::max(b.max, w);
+      }
+      return b;
+    }
+  };
+  return std::visit(Visitor{}, brush.shape);
+}
+
+// A store is edited in place: each edit (all of them with --batch) runs on a
+// window of the chunks its brush meets plus one chunk of margin, the chunks
+// it changed go back to the pager (later windows see them), and the end
+// commits them all to the log as one commit (atomic: all or none).
+int run_store_edit(const EditArgs& a, const CommonOptions& common) {
+  if (!a.output.empty()) {
+    return fail("edit", "-o " + a.output + ": a .ldcs store (" + a.input +
+                            ") is edited in place, in one atomic commit; copy it first to keep the original");
+  }
+  if (!a.mesh.empty()) {
+    return fail("edit", "--mesh is for .ldc worlds; contour the edited part of the store " + a.input +
+                            " with ldc contour --region");
+  }
+  if (a.validate) return fail("edit", "--validate is for .ldc worlds, not the store " + a.input);
+  Result<std::vector<ScriptEdit>> edits = read_edit_script(a.script);  // a bad script fails before the store opens
+  if (!edits.ok()) return fail("edit", edits.status());
+  const std::vector<ScriptEdit>& list = edits.value();
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (list[i].edit.op == EditOp::kIntersect) {
+      return fail("edit", a.script + ": edit " + std::to_string(i) + " (intersect " + list[i].brush_name +
+                              ") would remove everything outside its brush across the whole store " + a.input +
+                              "; stores take union, subtract and paint");
+    }
+  }
+  Result<Store> store = open_store(a.input);
+  if (!store.ok()) return fail("edit", store.status());
+  const SourceLayout& layout = store->source->layout();
+  // Groups of edits that share a window: each edit alone, or all with --batch.
+  std::vector<std::vector<size_t>> groups;
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (!a.batch || groups.empty()) groups.emplace_back();
+    groups.back().push_back(i);
+  }
+  std::vector<ChunkRange> windows;
+  for (const std::vector<size_t>& group : groups) {  // every window bounded before anything is paged
+    ChunkRange wanted;
+    for (size_t k = 0; k < group.size(); ++k) {
+      const ScriptEdit& e = list[group[k]];
+      const std::string what = "edit " + std::to_string(group[k]) + " (" + edit_op_name(e.edit.op) + " " +
+                               e.brush_name + ")";
+      // The brush's box grown by two cells (its rasterization covers it plus a cell).
+      const WorldBox box = brush_box(e.edit.brush);
+      const glm::dvec3 grow(2.0 * layout.lattice.cell_size);
+      if (!std::isfinite(box.min.x + box.min.y + box.min.z + box.max.x + box.max.y + box.max.z)) {
+        return fail("edit", what + ": the brush has no finite bounds");
+      }
+      Result<ChunkRange> r = chunks_of_box(layout, box.min - grow, box.max + grow, 0, what);
+      if (!r.ok()) return fail("edit", r.status());
+      wanted = k == 0 ? r.value() : ChunkRange{glm::min(wanted.lo, r->lo), glm::max(wanted.hi, r->hi)};
+    }
+    const std::string what = a.batch ? "the batch's window" : "edit " + std::to_string(group[0]) + "'s window";
+    Result<ChunkRange> window = clip_chunks(layout, wanted, 1, what);
+    if (!window.ok()) return fail("edit", window.status());
+    windows.push_back(window.value());
+  }
+  ProgressBar bar(!common.quiet);
+  nlohmann::json report = {{"input", a.input}, {"script", a.script}, {"output", a.input},
+                           {"edits", nlohmann::json::array()}, {"seconds", {{"page", 0.0}, {"edits", 0.0}}}};
+  PagedWorld paged(store->source);
+  ScriptProgress progress(bar.context(), list.size());
+  size_t paged_slots = 0;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    ScopedTimer page(nullptr, "");
+    Result<World> window = paged.window(windows[g].lo, windows[g].hi, bar.context());
+    report["seconds"]["page"] = report["seconds"]["page"].get<double>() + page.seconds();
+    if (!window.ok()) return fail("edit", window.status());
+    paged_slots += size_t(windows[g].slots());
+    ScopedTimer apply(nullptr, "");
+    WorldEditor editor(std::move(window).value());
+    if (a.batch) {
+      std::vector<WorldEditor::Edit> batch;
+      for (const ScriptEdit& e : list) batch.push_back(e.edit);
+      ScopedTimer t(nullptr, "");
+      Result<EditReceipt> r = editor.apply_batch(batch, bar.context());
+      if (!r.ok()) return fail("edit", "the batch failed: " + r.status().message() + "; nothing committed");
+      for (size_t i = 0; i < list.size(); ++i) report["edits"].push_back(edit_json(i, list[i]));
+      report["batch"] = {{"chunks_changed", r.value().changed_chunks.size()}, {"ms", 1000.0 * t.seconds()}};
+    } else {
+      const size_t i = groups[g][0];
+      ScopedTimer t(nullptr, "");
+      Result<EditReceipt> r = editor.apply(list[i].edit.brush, list[i].edit.op, progress.at(i));
+      if (!r.ok()) {
+        return fail("edit", "edit " + std::to_string(i) + " (" + edit_op_name(list[i].edit.op) + " " +
+                                list[i].brush_name + ") failed: " + r.status().message() + "; nothing committed");
+      }
+      nlohmann::json entry = edit_json(i, list[i]);
+      entry["chunks_changed"] = r.value().changed_chunks.size();
+      entry["ms"] = 1000.0 * t.seconds();
+      report["edits"].push_back(entry);
+    }
+    std::vector<glm::ivec3> changed;
+    for (const DirtyChunk& d : editor.take_dirty()) changed.push_back(d.chunk);
+    if (Status s = paged.put(editor.world(), changed); !s.ok()) return fail("edit", s);
+    report["seconds"]["edits"] = report["seconds"]["edits"].get<double>() + apply.seconds();
+  }
+  const size_t dirty = paged.stats().dirty;
+  ScopedTimer save(nullptr, "");
+  Status s = store->save(paged);
+  report["seconds"]["commit"] = save.seconds();
+  bar.finish();
+  if (!s.ok()) return fail("edit", s);  // the log keeps its previous commit
+  const ChunkLogStats st = store->log->stats();
+  report["chunks_committed"] = dirty;
+  report["chunks_paged"] = paged.stats().page_ins;
+  report["window_slots"] = paged_slots;
+  report["log"] = {{"commits", st.commits}, {"sequence", st.sequence}, {"live_chunks", st.live_chunks},
+                   {"file_bytes", st.file_bytes}, {"dead_fraction", st.dead_fraction()}};
+  report["ok"] = true;
+  if (common.json) {
+    std::printf("%s\n", json_text(report).c_str());
+  } else {
+    print_edit_lines(report);
+    if (dirty == 0) {
+      std::printf("no chunk changed: nothing committed to %s\n", a.input.c_str());
+    } else {
+      std::printf("committed %zu chunks to %s (commit %llu; %llu live chunks, %llu bytes)\n", dirty,
+                  a.input.c_str(), static_cast<unsigned long long>(st.sequence),
+                  static_cast<unsigned long long>(st.live_chunks), static_cast<unsigned long long>(st.file_bytes));
+    }
+    print_seconds(report["seconds"]);
+  }
+  return kExitSuccess;
+}
+
 int run_edit(const EditArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
+  if (is_store_file(a.input)) return run_store_edit(a, common);
+  if (a.output.empty()) return fail("edit", "-o is required for a .ldc world (" + a.input + ")");
   if (!has_ldc_extension(a.output)) return fail("edit", "-o " + a.output + ": the output must be a .ldc file");
   if (!a.mesh.empty()) {
     Result<MeshFormat> format = mesh_format_from_path(a.mesh);
@@ -197,10 +366,11 @@ int run_edit(const EditArgs& a, const CommonOptions& common) {
 void add_edit_command(CLI::App& app, CommonOptions& common) {
   auto args = std::make_shared<EditArgs>();
   CLI::App* cmd = app.add_subcommand("edit", "Apply a JSON script of brush edits (add, subtract, intersect, paint) "
-                                             "to a .ldc world");
-  cmd->add_option("input", args->input, ".ldc file")->required();
+                                             "to a .ldc world or a .ldcs store");
+  cmd->add_option("input", args->input, ".ldc file, or a .ldcs store (edited in place, one atomic commit)")->required();
   cmd->add_option("--script", args->script, "JSON edit script (format below)")->required();
-  cmd->add_option("-o,--output", args->output, "Output .ldc file (written only if every edit succeeds)")->required();
+  cmd->add_option("-o,--output", args->output,
+                  "Output .ldc file (written only if every edit succeeds); required for a .ldc input, refused for a store");
   cmd->add_flag("--batch", args->batch, "Apply all edits in one apply_batch (one undo step; per-batch counts)");
   cmd->add_flag("--validate", args->validate, "Validate the result; exit 2 and write nothing if invalid");
   cmd->add_option("--mesh", args->mesh,

@@ -296,7 +296,7 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
   Result<GiLights> lights = parse_lights(a, up_axis);
   if (!lights.ok()) return fail("gi", lights.status());
   ProgressBar bar(!common.quiet);
-  Result<World> w = load_world(a.world, {}, bar.context());
+  Result<World> w = load_world_file(a.world, {}, bar.context());
   bar.finish();
   if (!w.ok()) return fail("gi", w.status());
   Result<Camera> cam = make_camera(a.camera, up_axis, &w.value());

@@ -19,7 +19,7 @@ struct InsideArgs {
 
 int run_inside(const InsideArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
-  Result<World> w = load_world(a.world);
+  Result<World> w = load_world_file(a.world);
   if (!w.ok()) return fail("inside", w.status());
   Result<std::vector<glm::dvec3>> pts = [&]() -> Result<std::vector<glm::dvec3>> {
     if (a.points.empty()) return read_points(std::cin, "<stdin>");

@@ -51,7 +51,7 @@ struct PathArgs {
 };
 
 Result<World> load_input(const PathArgs& a, Context* ctx) {
-  if (has_ldc_extension(a.input)) return load_world(a.input, {}, ctx);
+  if (has_ldc_extension(a.input) || is_store_file(a.input)) return load_world_file(a.input, {}, ctx);
   if (!(a.cell_size > 0.0) || !std::isfinite(a.cell_size)) {
     return Status(ErrorCode::kInvalidArgument,
                   "--cell-size " + std::to_string(a.cell_size) + ": must be a finite number > 0");

@@ -179,7 +179,7 @@ int run_raycast(const RaycastArgs& a, const CommonOptions& common) {
   set_thread_count(common.threads);
   ProgressBar bar(!common.quiet);
   ScopedTimer load(nullptr, "");
-  Result<World> w = load_world(a.world, {}, bar.context());
+  Result<World> w = load_world_file(a.world, {}, bar.context());
   if (!w.ok()) return fail("raycast", w.status());
   const double load_seconds = load.seconds();
   Result<RaySource> src = make_rays(a, w.value());

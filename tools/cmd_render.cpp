@@ -109,7 +109,7 @@ int run_render(const RenderArgs& a, const CommonOptions& common) {
 
   ProgressBar bar(!common.quiet);
   ScopedTimer total(nullptr, "");
-  Result<World> w = load_world(a.world, {}, bar.context());
+  Result<World> w = load_world_file(a.world, {}, bar.context());
   if (!w.ok()) return fail("render", w.status());
   nlohmann::json seconds = {{"load", total.seconds()}};
   Result<Camera> cam = make_camera(a.camera, parse_up_axis(a.up, kLdcUpAxis).value(), &w.value());

@@ -206,7 +206,7 @@ int run_voxelize(const VoxelizeArgs& a, const CommonOptions& common) {
   if (a.cascades == 0 && !a.camera.empty()) return fail("voxelize", "--camera needs --cascades K");
   // A missing plugin is found before the (maybe long) voxelization.
   if (format.value() == Format::kVdb && !vdb_plugin().ok()) return fail("voxelize", vdb_plugin().status().message());
-  Result<World> world = load_world(a.world);
+  Result<World> world = load_world_file(a.world);
   if (!world.ok()) return fail("voxelize", world.status());
   ProgressBar bar(!common.quiet);
   Result<nlohmann::json> j = a.cascades > 0 ? run_cascades(a, world.value(), axis.value(), format.value(), bar.context())

@@ -273,6 +273,21 @@ bool has_ldc_extension(const std::string& path) {
   return ext == ".ldc";
 }
 
+bool is_store_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  char magic[4] = {};
+  return in.read(magic, 4) && std::string_view(magic, 4) == "LDCS";
+}
+
+Result<World> load_world_file(const std::string& path, const LoadLimits& limits, Context* ctx) {
+  if (is_store_file(path)) {
+    return Status(ErrorCode::kInvalidArgument,
+                  path + " is a .ldcs store (a large world's chunk log), not a .ldc world: use ldc contour " + path +
+                      " --region X0,Y0,Z0,X1,Y1,Z1, ldc edit " + path + " --script, or ldc info " + path);
+  }
+  return load_world(path, limits, ctx);
+}
+
 void add_up_option(CLI::App* cmd, std::string& up, const std::string& auto_means) {
   cmd->add_option("--up", up, "Up axis: x, y or z; auto: " + auto_means)->capture_default_str();
 }

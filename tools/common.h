@@ -28,6 +28,7 @@
 
 #include "ldc/build.h"
 #include "ldc/context.h"
+#include "ldc/io.h"
 #include "ldc/status.h"
 #include "ldc/world.h"
 
@@ -108,6 +109,12 @@ bool warn_if_rasterized_empty(const std::string& command, const World& world, co
 
 // Whether a path ends in .ldc (any case).
 bool has_ldc_extension(const std::string& path);
+// Whether the file starts with a chunk log's magic "LDCS" (a .ldcs store,
+// ldc/chunk_log.h), whatever its name; false when it cannot be read.
+bool is_store_file(const std::string& path);
+// load_world, but a .ldcs store is refused (kInvalidArgument) with a message
+// that names the file and the commands that read stores, before any of it is read.
+Result<World> load_world_file(const std::string& path, const LoadLimits& limits = {}, Context* ctx = nullptr);
 
 // --up, the world's up axis, shared by render, gi, voxelize and path: x, y or
 // z; "auto" (the default) is the input's convention, `auto_means` in the help.

@@ -10,9 +10,14 @@
 #include <string>
 #include <string_view>
 
+#include "cmd_store.h"  // add_compact_command (.ldcs stores, issue 21)
 #include "common.h"
 #include "ldc/io.h"
 #include "ldc/version.h"
+
+namespace ldc::tool {
+void add_bake_command(CLI::App& app, CommonOptions& common);  // tools/cmd_bake.cpp (issue 23)
+}  // namespace ldc::tool
 
 namespace {
 
@@ -61,11 +66,13 @@ int main(int argc, char** argv) {
   ldc::tool::add_contour_commands(app, common);
   ldc::tool::add_boolean_command(app, common);
   ldc::tool::add_edit_command(app, common);
+  ldc::tool::add_compact_command(app, common);
   ldc::tool::add_raycast_command(app, common);
   ldc::tool::add_render_command(app, common);
   ldc::tool::add_gi_command(app, common);
   ldc::tool::add_path_command(app, common);
   ldc::tool::add_voxelize_command(app, common);
+  ldc::tool::add_bake_command(app, common);
   for (CLI::App* command : app.get_subcommands({})) {  // after a command's own footer, if any
     const std::string own = command->get_footer();
     command->footer(own.empty() ? ldc::tool::kExitStatusHelp : own + "\n" + ldc::tool::kExitStatusHelp);

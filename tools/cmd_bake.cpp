@@ -1,0 +1,755 @@
+// ldc bake (issue 23): the offline bake of a large world, sharded for a batch
+// scheduler (a Slurm job array, a Kubernetes Indexed Job), and its merge.
+//
+//   ldc bake WORLD --out DIR --shard i/N [--products mesh,nav,voxels] [--lods 1]
+//   ldc bake --merge DIR
+//
+// Work units are chunk columns (x, y) holding at least one chunk that may be
+// mixed (read from the source's kinds where it knows them cheaply: the
+// procedural solid's box test, a store log's chunks, an .ldc world's kinds).
+// Every shard computes the same unit list and the same cut into N ranges of
+// equal cost (cost = possibly-mixed chunks of the column), so no shard talks
+// to another. Each unit's products are computed from a window of the unit's
+// column plus one chunk column around it (the whole z range), so a unit's
+// bytes depend on the unit and the world only, never on N or on which shard
+// baked it: the merged bake equals a one-process bake byte for byte.
+#include <algorithm>
+#include <atomic>
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "common.h"
+#include "contour/contour.h"
+#include "ldc/detail/crc32.h"
+#include "ldc/io.h"
+#include "ldc/store.h"
+#include "meshio/meshio.h"
+#include "nav/nav.h"
+#include "voxelize/voxelize.h"
+
+namespace ldc::tool {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kShardFormat = "ldc-bake-shard 1";
+constexpr const char* kIndexFormat = "ldc-bake-index 1";
+
+struct BakeArgs {
+  std::string world;
+  std::string out;
+  std::string shard;
+  std::string products = "mesh,nav,voxels";
+  int lods = 1;
+  std::string merge;
+  std::string terrain_size;  // procedural world without a file
+  double cell_size = 0.5;
+  int chunk_size = 32;
+  uint32_t seed = 1;
+};
+
+// An .ldc world as a chunk source.
+class WorldSource final : public ChunkSource {
+ public:
+  explicit WorldSource(World world) : world_(std::move(world)) {
+    layout_.lattice = world_.lattice();
+    layout_.chunk_size = world_.chunk_size();
+    layout_.box.chunk_origin = world_.chunk_origin();
+    layout_.box.chunk_dims = world_.chunk_dims();
+  }
+  const SourceLayout& layout() const override { return layout_; }
+  Result<StoredChunk> read(const glm::ivec3& chunk) const override {
+    if (!layout_.box.contains(chunk)) return StoredChunk{};
+    StoredChunk s;
+    s.kind = world_.chunk_kind(chunk);
+    if (s.kind == ChunkKind::kMixed) s.data = world_.chunk_shared(chunk);
+    return s;
+  }
+  const World& world() const { return world_; }
+
+ private:
+  World world_;
+  SourceLayout layout_;
+};
+
+struct BakeWorld {
+  std::string id;  // what the manifests record: the same text means the same world
+  std::shared_ptr<const ChunkSource> source;
+  // Whether a chunk may be mixed (cheap; false only when it certainly is not).
+  std::function<bool(const glm::ivec3&)> maybe_mixed;
+};
+
+std::function<bool(const glm::ivec3&)> implicit_classifier(const ImplicitSource& src) {
+  const SourceLayout layout = src.layout();
+  const WorldBox bounds = src.solid().bounds();
+  return [&src, layout, bounds](const glm::ivec3& c) {
+    const glm::dvec3 lo = layout.lattice.node_position(c * layout.chunk_size);
+    const glm::dvec3 hi = layout.lattice.node_position((c + 1) * layout.chunk_size);
+    if (hi.x < bounds.min.x || hi.y < bounds.min.y || hi.z < bounds.min.z || lo.x > bounds.max.x ||
+        lo.y > bounds.max.y || lo.z > bounds.max.z)
+      return false;
+    return src.solid().classify(WorldBox{lo, hi}) == ImplicitSolid::BoxClass::kUnknown;
+  };
+}
+
+std::string trim(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ' || s.back() == '\t')) s.pop_back();
+  size_t i = 0;
+  while (i < s.size() && (s[i] == ' ' || s[i] == '\t')) ++i;
+  return s.substr(i);
+}
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+  if (s.size() < suffix.size()) return false;
+  std::string tail = s.substr(s.size() - suffix.size());
+  std::transform(tail.begin(), tail.end(), tail.begin(), [](unsigned char ch) { return char(std::tolower(ch)); });
+  return tail == suffix;
+}
+
+Result<BakeWorld> describe_source(const std::string& description) {
+  Result<std::shared_ptr<const ChunkSource>> src = source_from_description(description);
+  if (!src.ok()) return src.status();
+  BakeWorld w;
+  w.id = description;
+  w.source = src.value();
+  if (auto imp = std::dynamic_pointer_cast<const ImplicitSource>(w.source)) {
+    w.maybe_mixed = implicit_classifier(*imp);
+  } else {
+    auto s = w.source;
+    w.maybe_mixed = [s](const glm::ivec3& c) {
+      Result<StoredChunk> r = s->read(c);
+      return !r.ok() || r.value().kind == ChunkKind::kMixed;
+    };
+  }
+  return w;
+}
+
+Result<BakeWorld> open_bake_world(const BakeArgs& a) {
+  if (!a.terrain_size.empty()) {
+    if (!a.world.empty())
+      return Status(ErrorCode::kInvalidArgument, "give either WORLD or --terrain-size, not both");
+    std::vector<double> size;
+    if (!parse_numbers(a.terrain_size, &size) || size.size() != 2)
+      return Status(ErrorCode::kInvalidArgument, "--terrain-size: expected X,Y in metres, got '" + a.terrain_size + "'");
+    TerrainConfig config;
+    config.seed = a.seed;
+    config.size_x = size[0];
+    config.size_y = size[1];
+    if (Status s = check_terrain(config); !s.ok()) return s;
+    return describe_source(terrain_source_description(config, a.cell_size, a.chunk_size));
+  }
+  if (a.world.empty()) return Status(ErrorCode::kInvalidArgument, "give WORLD (a .ldcs store, an .ldc world, a description file or text) or --terrain-size X,Y");
+  std::error_code ec;
+  if (ends_with(a.world, ".ldcs")) {
+    Result<Store> store = open_store(a.world);
+    if (!store.ok()) return store.status();
+    BakeWorld w;
+    const ChunkLogStats st = store.value().log->stats();
+    w.id = store.value().log->base_description() + " | store sequence=" + std::to_string(st.sequence) +
+           " live_chunks=" + std::to_string(st.live_chunks);
+    std::function<bool(const glm::ivec3&)> base_test;
+    if (auto imp = std::dynamic_pointer_cast<const ImplicitSource>(store.value().base)) base_test = implicit_classifier(*imp);
+    auto keep = std::make_shared<Store>(std::move(store.value()));
+    w.source = keep->source;
+    w.maybe_mixed = [keep, base_test](const glm::ivec3& c) {
+      Result<std::optional<StoredChunk>> f = keep->log->find(c);
+      if (!f.ok()) return true;
+      if (f.value().has_value()) return f.value()->kind == ChunkKind::kMixed;
+      if (base_test) return base_test(c);
+      Result<StoredChunk> r = keep->base->read(c);
+      return !r.ok() || r.value().kind == ChunkKind::kMixed;
+    };
+    return w;
+  }
+  if (has_ldc_extension(a.world)) {
+    Result<std::string> bytes = read_file(a.world);
+    if (!bytes.ok()) return bytes.status();
+    Result<World> world = deserialize_world(bytes.value(), a.world);
+    if (!world.ok()) return world.status();
+    char crc[16];
+    std::snprintf(crc, sizeof crc, "%08x",
+                  detail::crc32(reinterpret_cast<const uint8_t*>(bytes.value().data()), bytes.value().size()));
+    BakeWorld w;
+    w.id = "ldc-world crc32=" + std::string(crc) + " bytes=" + std::to_string(bytes.value().size());
+    auto src = std::make_shared<const WorldSource>(std::move(world.value()));
+    w.source = src;
+    w.maybe_mixed = [src](const glm::ivec3& c) {
+      return src->layout().box.contains(c) && src->world().chunk_kind(c) == ChunkKind::kMixed;
+    };
+    return w;
+  }
+  if (fs::is_regular_file(a.world, ec)) {
+    Result<std::string> text = read_file(a.world, 1 << 20);
+    if (!text.ok()) return text.status();
+    return describe_source(trim(text.value()));
+  }
+  if (a.world.rfind("ldc-terrain", 0) == 0) return describe_source(trim(a.world));
+  return Status(ErrorCode::kIoError, a.world + ": no such file (WORLD is a .ldcs store, an .ldc world, a file holding a world description, or the description text)");
+}
+
+struct Products {
+  bool mesh = false, nav = false, voxels = false;
+  std::vector<std::string> names() const {
+    std::vector<std::string> n;
+    if (mesh) n.push_back("mesh");
+    if (nav) n.push_back("nav");
+    if (voxels) n.push_back("voxels");
+    return n;
+  }
+};
+
+Result<Products> parse_products(const std::string& text) {
+  Products p;
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t comma = text.find(',', start);
+    const std::string item = text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (item == "mesh") p.mesh = true;
+    else if (item == "nav") p.nav = true;
+    else if (item == "voxels") p.voxels = true;
+    else return Status(ErrorCode::kInvalidArgument, "--products: unknown product '" + item + "' (expected mesh, nav, voxels)");
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return p;
+}
+
+struct Unit {
+  glm::ivec2 column{0};
+  int64_t cost = 0;
+};
+
+// Every column of the source's box with a chunk that may be mixed, in chunk
+// order (y, then x), with its cost; the same list in every shard.
+std::vector<Unit> plan_units(const BakeWorld& w) {
+  const SourceBox box = w.source->layout().box;
+  const int nx = box.chunk_dims.x, ny = box.chunk_dims.y;
+  std::vector<int64_t> cost(size_t(nx) * size_t(ny), 0);
+  tbb::parallel_for(0, ny, [&](int y) {
+    for (int x = 0; x < nx; ++x)
+      for (int z = 0; z < box.chunk_dims.z; ++z)
+        if (w.maybe_mixed(box.chunk_origin + glm::ivec3(x, y, z))) ++cost[size_t(y) * nx + x];
+  });
+  std::vector<Unit> units;
+  for (int y = 0; y < ny; ++y)
+    for (int x = 0; x < nx; ++x)
+      if (int64_t c = cost[size_t(y) * nx + x]; c > 0)
+        units.push_back({glm::ivec2(box.chunk_origin.x + x, box.chunk_origin.y + y), c});
+  return units;
+}
+
+// Unit k goes to the shard whose equal-cost range holds the middle of its
+// cost: contiguous ranges, balanced by mixed chunks, identical in every shard.
+int shard_of(int64_t before, int64_t cost, int64_t total, int n) {
+  const long double mid = (long double)before + (long double)cost / 2.0L;
+  int s = int(mid * n / (long double)total);
+  return std::clamp(s, 0, n - 1);
+}
+
+struct FileEntry {
+  std::string name;  // relative to the shard folder (and to the merged folder)
+  uint64_t bytes = 0;
+  uint32_t crc = 0;
+};
+
+std::string hex32(uint32_t v) {
+  char b[16];
+  std::snprintf(b, sizeof b, "%08x", v);
+  return b;
+}
+
+uint32_t crc_of(const std::string& bytes) {
+  return detail::crc32(reinterpret_cast<const uint8_t*>(bytes.data()), bytes.size());
+}
+
+std::string chunk_name(const glm::ivec3& c) {
+  return std::to_string(c.x) + "_" + std::to_string(c.y) + "_" + std::to_string(c.z);
+}
+
+struct UnitResult {
+  std::vector<FileEntry> files;
+  size_t mixed_chunks = 0;
+  double seconds[4] = {0, 0, 0, 0};  // window, mesh, nav, voxels
+  uint64_t bytes[3] = {0, 0, 0};     // mesh, nav, voxels
+  Status status;
+};
+
+Status write_product(const fs::path& dir, const std::string& name, const std::string& bytes, UnitResult& r, int product) {
+  Status s = write_file_atomically((dir / name).string(), bytes);
+  if (!s.ok()) return s;
+  r.files.push_back({name, bytes.size(), crc_of(bytes)});
+  r.bytes[product] += bytes.size();
+  return Status();
+}
+
+UnitResult bake_unit(const Unit& u, PagedWorld& paged, std::mutex& paged_mutex, const Products& p, const fs::path& dir) {
+  UnitResult r;
+  const SourceLayout layout = paged.layout();
+  const int z0 = layout.box.chunk_origin.z, z1 = z0 + layout.box.chunk_dims.z;
+  const int C = layout.chunk_size;
+  const double h = layout.lattice.cell_size;
+  ScopedTimer tw(nullptr, "");
+  Result<World> window = [&]() -> Result<World> {
+    std::lock_guard lock(paged_mutex);
+    return paged.window(glm::ivec3(u.column.x - 1, u.column.y - 1, z0), glm::ivec3(u.column.x + 2, u.column.y + 2, z1));
+  }();
+  if (!window.ok()) {
+    r.status = window.status();
+    return r;
+  }
+  const World& w = window.value();
+  r.seconds[0] = tw.seconds();
+  for (int z = z0; z < z1; ++z)
+    if (w.chunk_kind(glm::ivec3(u.column, z)) == ChunkKind::kMixed) ++r.mixed_chunks;
+  if (p.mesh) {
+    ScopedTimer t(nullptr, "");
+    for (int z = z0; z < z1 && r.status.ok(); ++z) {
+      const glm::ivec3 c(u.column, z);
+      Result<ChunkMesh> m = contour_chunk(w, c);
+      if (!m.ok()) {
+        r.status = m.status();
+        break;
+      }
+      if (m.value().mesh.triangles.empty()) continue;
+      const std::string name = "mesh/" + chunk_name(c) + ".glb";
+      // save_mesh writes atomically; its bytes are read back for the checksum.
+      Status s = save_mesh(m.value().mesh, (dir / name).string());
+      if (s.ok()) {
+        Result<std::string> bytes = read_file((dir / name).string());
+        if (!bytes.ok()) s = bytes.status();
+        else {
+          r.files.push_back({name, bytes.value().size(), crc_of(bytes.value())});
+          r.bytes[0] += bytes.value().size();
+        }
+      }
+      r.status = s;
+    }
+    r.seconds[1] = t.seconds();
+  }
+  if (p.nav && r.status.ok()) {
+    ScopedTimer t(nullptr, "");
+    NavConfig config;
+    Result<NavMesh> nav = NavMesh::build(w, config);
+    if (!nav.ok()) {
+      r.status = nav.status();
+      return r;
+    }
+    NavQuery query(nav.value());
+    for (int z = z0; z < z1 && r.status.ok(); ++z) {
+      const glm::ivec3 c(u.column, z);
+      if (w.chunk_kind(c) != ChunkKind::kMixed) continue;
+      std::vector<float> heights(size_t(C) * C, std::nanf(""));
+      bool any = false;
+      const double zmid = layout.lattice.node_position(glm::ivec3(0, 0, z * C)).z + 0.5 * C * h;
+      for (int v = 0; v < C; ++v)
+        for (int uu = 0; uu < C; ++uu) {
+          const glm::ivec3 node(c.x * C + uu, c.y * C + v, z * C);
+          glm::dvec3 pos = layout.lattice.node_position(node);
+          pos.z = zmid;
+          Result<NavPoint> np = query.nearest_walkable(pos, glm::dvec3(0.49 * h, 0.49 * h, 0.5 * C * h));
+          if (np.ok()) {
+            heights[size_t(v) * C + uu] = float(np.value().position.z);
+            any = true;
+          }
+        }
+      if (!any) continue;
+      std::string bytes(heights.size() * sizeof(float), '\0');
+      std::memcpy(bytes.data(), heights.data(), bytes.size());
+      r.status = write_product(dir, "nav/" + chunk_name(c) + ".nav", bytes, r, 1);
+    }
+    r.seconds[2] = t.seconds();
+  }
+  if (p.voxels && r.status.ok()) {
+    ScopedTimer t(nullptr, "");
+    VoxelConfig config;
+    config.voxel_size = 2.0 * h;
+    const int m = 2, n = C / m;
+    for (int z = z0; z < z1 && r.status.ok(); ++z) {
+      const glm::ivec3 c(u.column, z);
+      if (w.chunk_kind(c) != ChunkKind::kMixed) continue;
+      VoxelizeOptions options;
+      options.box = VoxelBox{c * n, glm::ivec3(n)};
+      Result<VoxelGrid> grid = voxelize(w, config, options);
+      if (!grid.ok()) {
+        r.status = grid.status();
+        break;
+      }
+      std::string bytes(grid.value().occupancy.size(), '\0');
+      for (size_t i = 0; i < bytes.size(); ++i)
+        bytes[i] = char(uint8_t(std::lround(std::clamp(grid.value().occupancy[i], 0.0f, 1.0f) * 255.0f)));
+      r.status = write_product(dir, "voxels/" + chunk_name(c) + ".occ", bytes, r, 2);
+    }
+    r.seconds[3] = t.seconds();
+  }
+  return r;
+}
+
+// --- Manifests ------------------------------------------------------------------
+
+Result<nlohmann::json> read_json(const fs::path& path) {
+  Result<std::string> text = read_file(path.string(), uint64_t{1} << 30);
+  if (!text.ok()) return text.status();
+  nlohmann::json j = nlohmann::json::parse(text.value(), nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return Status(ErrorCode::kCorruptData, path.string() + ": not a JSON object");
+  return j;
+}
+
+// Checks every file a manifest lists against its size and CRC-32; the error names the file.
+Status check_files(const fs::path& shard_dir, const nlohmann::json& manifest, size_t* files_checked) {
+  try {
+    for (const auto& unit : manifest.at("units"))
+      for (const auto& f : unit.at("files")) {
+        const std::string name = f.at("name").get<std::string>();
+        if (name.empty() || name.find("..") != std::string::npos || name[0] == '/')
+          return Status(ErrorCode::kCorruptData, (shard_dir / "manifest.json").string() + ": bad file name '" + name + "'");
+        const fs::path path = shard_dir / name;
+        Result<std::string> bytes = read_file(path.string());
+        if (!bytes.ok()) return Status(ErrorCode::kCorruptData, path.string() + ": missing or unreadable (" + bytes.status().message() + ")");
+        if (bytes.value().size() != f.at("bytes").get<uint64_t>() || hex32(crc_of(bytes.value())) != f.at("crc32").get<std::string>())
+          return Status(ErrorCode::kCorruptData, path.string() + ": checksum mismatch (the manifest says " +
+                                                     std::to_string(f.at("bytes").get<uint64_t>()) + " bytes, crc32 " +
+                                                     f.at("crc32").get<std::string>() + "; the file has " +
+                                                     std::to_string(bytes.value().size()) + " bytes, crc32 " +
+                                                     hex32(crc_of(bytes.value())) + ")");
+        if (files_checked) ++*files_checked;
+      }
+  } catch (const nlohmann::json::exception& e) {
+    return Status(ErrorCode::kCorruptData, (shard_dir / "manifest.json").string() + ": malformed manifest (" + e.what() + ")");
+  }
+  return Status();
+}
+
+// Refuses an output folder holding another world's bake (any shard manifest or index).
+Status check_same_world(const fs::path& out, const std::string& world_id, const std::string& products, int shards) {
+  std::error_code ec;
+  std::vector<fs::path> manifests;
+  if (fs::exists(out / "index.json", ec)) manifests.push_back(out / "index.json");
+  if (fs::is_directory(out / "shards", ec))
+    for (const auto& e : fs::directory_iterator(out / "shards", ec))
+      if (fs::exists(e.path() / "manifest.json", ec)) manifests.push_back(e.path() / "manifest.json");
+  std::sort(manifests.begin(), manifests.end());
+  for (const fs::path& m : manifests) {
+    Result<nlohmann::json> j = read_json(m);
+    if (!j.ok()) continue;  // a broken manifest is redone (own shard) or refused at merge
+    const std::string other = j.value().value("world", std::string());
+    if (other != world_id)
+      return Status(ErrorCode::kInvalidArgument, out.string() + " holds another world's bake (" + m.string() +
+                                                     " is of world '" + other + "', this bake is of '" + world_id +
+                                                     "'); use another --out");
+    if (shards > 0 && j.value().contains("shards") && j.value().value("shards", 0) != shards)
+      return Status(ErrorCode::kInvalidArgument, out.string() + " holds a bake in " + std::to_string(j.value().value("shards", 0)) +
+                                                     " shards, not " + std::to_string(shards) + " (" + m.string() + "); use another --out");
+    std::string other_products;
+    if (j.value().contains("products"))
+      for (const auto& pr : j.value()["products"]) other_products += (other_products.empty() ? "" : ",") + pr.get<std::string>();
+    if (other_products != products)
+      return Status(ErrorCode::kInvalidArgument, out.string() + " holds a bake of other products (" + m.string() +
+                                                     ": " + other_products + "; this bake: " + products + ")");
+  }
+  return Status();
+}
+
+std::string join(const std::vector<std::string>& v) {
+  std::string s;
+  for (const auto& x : v) s += (s.empty() ? "" : ",") + x;
+  return s;
+}
+
+Result<std::pair<int, int>> parse_shard(const std::string& text) {
+  const size_t slash = text.find('/');
+  auto number = [](const std::string& s, long long* v) {
+    if (s.empty() || s.size() > 9 || s.find_first_not_of("0123456789") != std::string::npos) return false;
+    *v = std::stoll(s);
+    return true;
+  };
+  long long i = 0, n = 0;
+  if (slash == std::string::npos || !number(text.substr(0, slash), &i) || !number(text.substr(slash + 1), &n))
+    return Status(ErrorCode::kInvalidArgument, "--shard: expected i/N (two whole numbers), got '" + text + "'");
+  if (n == 0) return Status(ErrorCode::kInvalidArgument, "--shard " + text + ": N = 0 (the shard count must be at least 1)");
+  if (i >= n)
+    return Status(ErrorCode::kInvalidArgument, "--shard " + text + ": shard index " + std::to_string(i) +
+                                                   " out of range for " + std::to_string(n) + " shards (0 .. " +
+                                                   std::to_string(n - 1) + ")");
+  return std::make_pair(int(i), int(n));
+}
+
+int run_bake(const BakeArgs& a, const CommonOptions& common) {
+  const std::string cmd = "bake";
+  set_thread_count(common.threads);
+  if (a.out.empty()) return fail(cmd, "--out DIR is required (or give --merge DIR)");
+  if (a.shard.empty()) return fail(cmd, "--shard i/N is required (0/1 bakes everything in one process)");
+  Result<std::pair<int, int>> shard = parse_shard(a.shard);
+  if (!shard.ok()) return fail(cmd, shard.status());
+  const int si = shard.value().first, sn = shard.value().second;
+  if (a.lods != 1) return fail(cmd, "--lods " + std::to_string(a.lods) + ": only 1 is supported (the library has no LOD meshes yet)");
+  Result<Products> products = parse_products(a.products);
+  if (!products.ok()) return fail(cmd, products.status());
+  const std::string product_list = join(products.value().names());
+  ScopedTimer total(nullptr, "");
+  Result<BakeWorld> world = open_bake_world(a);
+  if (!world.ok()) return fail(cmd, world.status());
+  const fs::path out(a.out);
+  if (Status s = check_same_world(out, world.value().id, product_list, sn); !s.ok()) return fail(cmd, s);
+  const fs::path dir = out / "shards" / std::to_string(si);
+  const fs::path manifest_path = dir / "manifest.json";
+  std::error_code ec;
+  // A finished shard (its manifest present and every file checking out) is skipped.
+  if (fs::exists(manifest_path, ec)) {
+    Result<nlohmann::json> m = read_json(manifest_path);
+    size_t checked = 0;
+    Status s = m.ok() ? check_files(dir, m.value(), &checked) : m.status();
+    if (s.ok() && (m.value().value("shards", -1) != sn || m.value().value("shard", -1) != si))
+      s = Status(ErrorCode::kCorruptData, manifest_path.string() + " is of shard " +
+                                              std::to_string(m.value().value("shard", -1)) + "/" +
+                                              std::to_string(m.value().value("shards", -1)));
+    if (s.ok()) {
+      if (common.json)
+        std::printf("%s\n", json_text(with_warnings({{"shard", si}, {"shards", sn}, {"skipped", true}, {"files_checked", checked}})).c_str());
+      else
+        std::printf("shard %d/%d already baked (%zu files checked against %s); skipped\n", si, sn, checked,
+                    manifest_path.string().c_str());
+      return kExitSuccess;
+    }
+    if (m.ok() && m.value().value("shards", sn) != sn)
+      return fail(cmd, out.string() + " holds a bake in " + std::to_string(m.value().value("shards", 0)) +
+                           " shards, not " + std::to_string(sn) + " (" + manifest_path.string() + "); use another --out");
+    warn(cmd, "re-baking shard " + std::to_string(si) + ": " + s.message());
+    fs::remove(manifest_path, ec);
+  }
+  ScopedTimer tplan(nullptr, "");
+  const std::vector<Unit> all = plan_units(world.value());
+  int64_t total_cost = 0;
+  for (const Unit& u : all) total_cost += u.cost;
+  std::vector<Unit> mine;
+  int64_t before = 0;
+  for (const Unit& u : all) {
+    if (shard_of(before, u.cost, total_cost, sn) == si) mine.push_back(u);
+    before += u.cost;
+  }
+  const double plan_seconds = tplan.seconds();
+  for (const char* sub : {"mesh", "nav", "voxels"}) {
+    fs::create_directories(dir / sub, ec);
+    if (ec) return fail(cmd, (dir / sub).string() + ": cannot create the folder (" + ec.message() + ")");
+  }
+  ProgressBar bar(!common.quiet);
+  PagedWorld paged(world.value().source);
+  std::mutex paged_mutex;
+  std::vector<UnitResult> results(mine.size());
+  std::atomic<size_t> done{0};
+  std::mutex progress_mutex;
+  ScopedTimer tbake(nullptr, "");
+  tbb::parallel_for(size_t(0), mine.size(), [&](size_t k) {
+    results[k] = bake_unit(mine[k], paged, paged_mutex, products.value(), dir);
+    const size_t d = ++done;
+    std::lock_guard lock(progress_mutex);
+    bar.context()->report_progress("bake", double(d) / double(mine.size()));
+  }, tbb::simple_partitioner());
+  bar.finish();
+  const double bake_seconds = tbake.seconds();
+  nlohmann::json units = nlohmann::json::array();
+  size_t files = 0, mixed = 0;
+  uint64_t bytes[3] = {0, 0, 0};
+  double seconds[4] = {0, 0, 0, 0};
+  for (size_t k = 0; k < mine.size(); ++k) {
+    const UnitResult& r = results[k];
+    if (!r.status.ok())
+      return fail(cmd, "column " + std::to_string(mine[k].column.x) + "," + std::to_string(mine[k].column.y) + ": " + r.status.message());
+    nlohmann::json fl = nlohmann::json::array();
+    for (const FileEntry& f : r.files) fl.push_back({{"name", f.name}, {"bytes", f.bytes}, {"crc32", hex32(f.crc)}});
+    units.push_back({{"column", {mine[k].column.x, mine[k].column.y}}, {"cost", mine[k].cost}, {"files", fl}});
+    files += r.files.size();
+    mixed += r.mixed_chunks;
+    for (int i = 0; i < 3; ++i) bytes[i] += r.bytes[i];
+    for (int i = 0; i < 4; ++i) seconds[i] += r.seconds[i];
+  }
+  const SourceLayout layout = world.value().source->layout();
+  nlohmann::json manifest = {{"format", kShardFormat},
+                             {"world", world.value().id},
+                             {"shard", si},
+                             {"shards", sn},
+                             {"products", products.value().names()},
+                             {"lods", a.lods},
+                             {"chunk_size", layout.chunk_size},
+                             {"cell_size", layout.lattice.cell_size},
+                             {"units_total", all.size()},
+                             {"cost_total", total_cost},
+                             {"units", units}};
+  if (Status s = write_file_atomically(manifest_path.string(), json_text(manifest, 1) + "\n"); !s.ok()) return fail(cmd, s);
+  const double chunk_m = layout.chunk_size * layout.lattice.cell_size;
+  const double km2 = double(mine.size()) * chunk_m * chunk_m * 1e-6;
+  nlohmann::json report = {{"shard", si},
+                           {"shards", sn},
+                           {"skipped", false},
+                           {"units", mine.size()},
+                           {"units_total", all.size()},
+                           {"cost", before},
+                           {"mixed_chunks", mixed},
+                           {"files", files},
+                           {"area_km2", km2},
+                           {"bytes", {{"mesh", bytes[0]}, {"nav", bytes[1]}, {"voxels", bytes[2]}}},
+                           {"seconds",
+                            {{"total", total.seconds()},
+                             {"plan", plan_seconds},
+                             {"bake_wall", bake_seconds},
+                             {"window_cpu", seconds[0]},
+                             {"mesh_cpu", seconds[1]},
+                             {"nav_cpu", seconds[2]},
+                             {"voxels_cpu", seconds[3]}}}};
+  if (common.json) {
+    std::printf("%s\n", json_text(with_warnings(report)).c_str());
+  } else {
+    std::printf("baked shard %d/%d: %zu of %zu columns, %zu mixed chunks, %zu files (mesh %" PRIu64 " B, nav %" PRIu64
+                " B, voxels %" PRIu64 " B) in %.2f s\n  manifest: %s\n",
+                si, sn, mine.size(), all.size(), mixed, files, bytes[0], bytes[1], bytes[2], total.seconds(),
+                manifest_path.string().c_str());
+  }
+  return kExitSuccess;
+}
+
+// --- Merge ----------------------------------------------------------------------
+
+int run_merge(const BakeArgs& a, const CommonOptions& common) {
+  const std::string cmd = "bake --merge";
+  const fs::path out(a.merge);
+  std::error_code ec;
+  if (!fs::is_directory(out / "shards", ec)) return fail(cmd, (out / "shards").string() + ": no shards folder (nothing baked here)");
+  std::map<long long, fs::path> found;
+  for (const auto& e : fs::directory_iterator(out / "shards", ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos || name.size() > 9)
+      return fail(cmd, e.path().string() + ": not a shard folder (expected a shard number)");
+    found[std::stoll(name)] = e.path();
+  }
+  if (found.empty()) return fail(cmd, (out / "shards").string() + ": no shards");
+  // N from the first manifest found; every other must agree.
+  std::string world_id;
+  std::vector<std::string> products;
+  int n = -1;
+  std::vector<nlohmann::json> manifests;
+  for (const auto& [index, path] : found) {
+    if (!fs::exists(path / "manifest.json", ec))
+      return fail(cmd, "shard " + std::to_string(index) + " is not finished: " + (path / "manifest.json").string() +
+                           " is missing (re-run that shard)");
+    Result<nlohmann::json> m = read_json(path / "manifest.json");
+    if (!m.ok()) return fail(cmd, m.status());
+    const nlohmann::json& j = m.value();
+    if (j.value("format", std::string()) != kShardFormat)
+      return fail(cmd, (path / "manifest.json").string() + ": not a bake shard manifest");
+    const int shards = j.value("shards", -1);
+    if (shards <= 0) return fail(cmd, (path / "manifest.json").string() + ": N = " + std::to_string(shards) + " (the shard count must be at least 1)");
+    if (j.value("shard", -1) != index)
+      return fail(cmd, (path / "manifest.json").string() + " says shard " + std::to_string(j.value("shard", -1)) +
+                           ", but lies in folder " + std::to_string(index));
+    if (n < 0) {
+      n = shards;
+      world_id = j.value("world", std::string());
+      products = j.value("products", std::vector<std::string>());
+    }
+    if (shards != n)
+      return fail(cmd, (path / "manifest.json").string() + ": a bake in " + std::to_string(shards) + " shards, the others in " + std::to_string(n));
+    if (index >= n)
+      return fail(cmd, path.string() + ": shard index " + std::to_string(index) + " out of range for " +
+                           std::to_string(n) + " shards (0 .. " + std::to_string(n - 1) + ")");
+    if (j.value("world", std::string()) != world_id)
+      return fail(cmd, (path / "manifest.json").string() + ": shard of another world ('" + j.value("world", std::string()) +
+                           "', not '" + world_id + "')");
+    if (j.value("products", std::vector<std::string>()) != products)
+      return fail(cmd, (path / "manifest.json").string() + ": shard of other products");
+    if (Status s = check_files(path, j, nullptr); !s.ok()) return fail(cmd, s);
+    manifests.push_back(j);
+  }
+  for (int i = 0; i < n; ++i)
+    if (!found.count(i))
+      return fail(cmd, "shard " + std::to_string(i) + "/" + std::to_string(n) + " is missing (" +
+                           (out / "shards" / std::to_string(i)).string() + "); re-run it before merging");
+  if (Status s = check_same_world(out, world_id, join(products), n); !s.ok()) return fail(cmd, s);
+  // Units in column order across shards (each shard's are contiguous and in order).
+  nlohmann::json units = nlohmann::json::array();
+  size_t files = 0;
+  uint64_t bytes = 0;
+  int64_t units_total = -1;
+  for (int i = 0; i < n; ++i) {
+    const nlohmann::json& j = manifests[size_t(i)];
+    if (units_total < 0) units_total = j.value("units_total", int64_t{0});
+    for (const auto& u : j.at("units")) {
+      units.push_back(u);
+      for (const auto& f : u.at("files")) {
+        const std::string name = f.at("name").get<std::string>();
+        const fs::path target = out / name;
+        fs::create_directories(target.parent_path(), ec);
+        fs::remove(target, ec);
+        fs::create_hard_link(out / "shards" / std::to_string(i) / name, target, ec);
+        if (ec) {
+          ec.clear();
+          fs::copy_file(out / "shards" / std::to_string(i) / name, target, fs::copy_options::overwrite_existing, ec);
+          if (ec) return fail(cmd, target.string() + ": cannot link or copy (" + ec.message() + ")");
+        }
+        ++files;
+        bytes += f.at("bytes").get<uint64_t>();
+      }
+    }
+  }
+  if (int64_t(units.size()) != units_total)
+    return fail(cmd, "the shards hold " + std::to_string(units.size()) + " columns, the plan " + std::to_string(units_total));
+  const nlohmann::json& first = manifests[0];
+  // The index does not depend on N: the same world baked in any number of
+  // shards gives the same index.json, and the same files beside it.
+  nlohmann::json index = {{"format", kIndexFormat},
+                          {"world", world_id},
+                          {"products", products},
+                          {"lods", first.value("lods", 1)},
+                          {"chunk_size", first.value("chunk_size", 0)},
+                          {"cell_size", first.value("cell_size", 0.0)},
+                          {"units", units}};
+  if (Status s = write_file_atomically((out / "index.json").string(), json_text(index, 1) + "\n"); !s.ok()) return fail(cmd, s);
+  if (common.json)
+    std::printf("%s\n", json_text(with_warnings({{"shards", n}, {"units", units.size()}, {"files", files}, {"bytes", bytes}, {"index", (out / "index.json").string()}})).c_str());
+  else
+    std::printf("merged %d shards: %zu columns, %zu files, %" PRIu64 " bytes, every checksum verified\n  index: %s\n", n,
+                units.size(), files, bytes, (out / "index.json").string().c_str());
+  return kExitSuccess;
+}
+
+}  // namespace
+
+void add_bake_command(CLI::App& app, CommonOptions& common) {
+  auto a = std::make_shared<BakeArgs>();
+  CLI::App* bake = app.add_subcommand(
+      "bake", "Offline bake of a large world's per-chunk products, one shard of a job array at a time; --merge checks and indexes them");
+  bake->add_option("world", a->world,
+                   "World: a .ldcs store, an .ldc world, a file holding a base description "
+                   "(terrain_source_description), or that text");
+  bake->add_option("--out", a->out, "Output folder (shards go to DIR/shards/i/)");
+  bake->add_option("--shard", a->shard, "This process's shard i/N (0/1: the whole world)");
+  bake->add_option("--products", a->products, "Products, comma-separated: mesh, nav, voxels")->capture_default_str();
+  bake->add_option("--lods", a->lods, "LOD meshes per chunk (only 1: the library has no LOD meshes yet)")->capture_default_str();
+  bake->add_option("--merge", a->merge, "Check every shard's manifest in DIR and write DIR/index.json");
+  bake->add_option("--terrain-size", a->terrain_size, "Procedural world instead of WORLD: the landscape of X,Y metres");
+  bake->add_option("--cell-size", a->cell_size, "With --terrain-size: cell size h [m]")->capture_default_str();
+  bake->add_option("--chunk-size", a->chunk_size, "With --terrain-size: chunk size C (8, 16, 32, 64)")->capture_default_str();
+  bake->add_option("--seed", a->seed, "With --terrain-size: the landscape's seed")->capture_default_str();
+  bake->callback([a, &common] {
+    int code;
+    if (!a->merge.empty()) {
+      code = (a->world.empty() && a->out.empty() && a->shard.empty() && a->terrain_size.empty())
+                 ? run_merge(*a, common)
+                 : fail("bake", "--merge DIR takes no WORLD, --out, --shard or --terrain-size");
+    } else {
+      code = run_bake(*a, common);
+    }
+    if (code != 0) throw CLI::RuntimeError(code);
+  });
+}
+
+}  // namespace ldc::tool
