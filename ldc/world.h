@@ -375,11 +375,13 @@ struct ValidateOptions {
 // rays through every lattice node agree on whether it is inside.
 ValidationReport validate(const World& world, const ValidateOptions& options = {});
 
-// Whether every ray starts and ends outside at the world's box faces: the
-// part of validate() that meshing relies on, in O(rays on the box faces).
-// A World that breaks it (a window of a PagedWorld, ldc/store.h, cut
-// through the solid) is refused by contour_world, ChunkedMesh::build and
-// marching_cubes. kInvalidArgument names the first face chunk and ray.
+// Whether every ray of a mixed chunk on the world's box faces starts and
+// ends outside there: the part of validate() that meshing relies on, in
+// O(rays on the box faces). A World that breaks it (a window of a
+// PagedWorld, ldc/store.h, cut through the ground) is refused by
+// contour_world, ChunkedMesh::build and marching_cubes; solid chunks on a
+// face are allowed (they mesh to nothing there). kInvalidArgument names the
+// first face chunk and ray.
 Status check_box_faces_outside(const World& world);
 
 // Checks the invariants local to one chunk (everything but cross-chunk

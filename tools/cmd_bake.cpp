@@ -31,7 +31,7 @@
 
 #include "common.h"
 #include "contour/contour.h"
-#include "ldc/detail/crc32.h"
+#include "ldc/internal/crc32.h"
 #include "ldc/io.h"
 #include "ldc/store.h"
 #include "meshio/meshio.h"

@@ -7,7 +7,7 @@
 #include <string>
 #include <string_view>
 
-#include "meshio/detail/codecs.h"
+#include "meshio/draco_codec.h"
 #include "meshio/draco_plugin.h"
 #include "plugin.h"
 

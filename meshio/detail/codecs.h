@@ -9,6 +9,7 @@
 #include <string_view>
 #include <vector>
 
+#include "meshio/draco_codec.h"
 #include "meshio/meshio.h"
 
 namespace ldc::meshio_detail {
@@ -38,17 +39,11 @@ std::vector<uint16_t> vertex_materials(const ContourMesh& mesh);
 // (area-weighted from the triangles) and vertex materials (most common).
 void complete_loaded_mesh(ContourMesh& mesh);
 
-// "path: message" with the given code.
-Status error_at(ErrorCode code, std::string_view path, std::string_view message);
+// error_at, encode_draco, decode_draco: meshio/draco_codec.h.
 
 // glTF 2.0 binary (gltf.cpp).
 Result<std::string> encode_glb(const ContourMesh& mesh, const ExportOptions& options,
                                const std::string& path);
 Result<ContourMesh> decode_glb(std::string_view bytes, const std::string& path);
-
-// Draco (draco.cpp).
-Result<std::string> encode_draco(const ContourMesh& mesh, const ExportOptions& options,
-                                 const std::string& path);
-Result<ContourMesh> decode_draco(std::string_view bytes, const std::string& path);
 
 }  // namespace ldc::meshio_detail
