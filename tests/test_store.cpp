@@ -3,19 +3,15 @@
 // back survive eviction, and a kilometre-wide source costs its window only.
 #include <gtest/gtest.h>
 
-#include <thread>
-
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <fstream>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
-
-#include <tbb/global_control.h>
 
 #include "contour/contour.h"
 #include "csg/csg.h"
@@ -462,50 +458,6 @@ TEST(Store, BadLayoutsAreRefusedNamingTheField) {
   EXPECT_EQ(paged.window_around(glm::dvec3(std::nan("")), 1.0).status().code(), ErrorCode::kInvalidArgument);
   EXPECT_EQ(paged.window_around(glm::dvec3(1.0), -1.0).status().code(), ErrorCode::kInvalidArgument);
   EXPECT_EQ(paged.window_around(glm::dvec3(1e300), 1.0).status().code(), ErrorCode::kInvalidArgument);
-}
-
-double thread_cpu_seconds() {
-  timespec t{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
-  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
-}
-
-// Timings for the report: not run by default.
-// ./build/tests/ldc_tests --gtest_also_run_disabled_tests --gtest_filter='StoreBench*'
-TEST(StoreBench, DISABLED_GenerationThroughput) {
-  TerrainConfig big;
-  big.size_x = 4000.0;
-  big.size_y = 4000.0;
-  auto source = make_terrain_source(big, 0.2, 32).value();
-  const SourceBox box = source->layout().box;
-  const glm::ivec3 mid = box.chunk_origin + box.chunk_dims / 2;
-  for (int threads : {1, 2}) {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
-    // Single chunks: mixed vs uniform.
-    double mixed_s = 0, uniform_s = 0;
-    int mixed = 0, uniform = 0;
-    for (int i = 0; i < 16; ++i) {
-      for (int z = box.chunk_origin.z; z < box_end(box).z; ++z) {
-        const double t0 = thread_cpu_seconds();  // CPU time: the test machine may be shared
-        StoredChunk c = source->read({mid.x + 40 + i, mid.y - 40, z}).value();
-        const double s = thread_cpu_seconds() - t0;
-        (c.kind == ChunkKind::kMixed ? mixed_s : uniform_s) += s;
-        ++(c.kind == ChunkKind::kMixed ? mixed : uniform);
-      }
-    }
-    // A window of 8 x 8 columns (x 3-4 chunks up) around a focus.
-    PagedWorld paged(source);
-    const glm::ivec3 lo(mid.x + threads * 20, mid.y, box.chunk_origin.z);
-    const auto t0 = std::chrono::steady_clock::now();
-    World w = paged.window(lo, lo + glm::ivec3(8, 8, 4)).value();
-    const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    const PagingStats st = paged.stats();
-    std::printf("threads %d: mixed chunk %.2f ms CPU (%d), uniform chunk %.4f ms CPU (%d); window %dx%dx%d: %.3f s, "
-                "%zu chunks (%zu mixed) = %.0f chunks/s, cache %.2f MiB\n",
-                threads, 1e3 * mixed_s / std::max(mixed, 1), mixed, 1e3 * uniform_s / std::max(uniform, 1),
-                uniform, w.chunk_dims().x, w.chunk_dims().y, w.chunk_dims().z, s, st.page_ins,
-                st.resident_mixed, double(st.page_ins) / s, double(st.resident_bytes) / 1048576.0);
-  }
 }
 
 // --- Stores: descriptions, a log over its base ---------------------------------
