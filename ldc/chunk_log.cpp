@@ -718,7 +718,9 @@ Status ChunkLog::compact() {
     if (Status st = copy_live_records(s, out, moved, offsets); !st.ok()) return st;
     std::vector<uint8_t> commit_record;
     if (!offsets.empty()) append_commit_record(commit_record, s.sequence, offsets);
-    if (std::fwrite(commit_record.data(), 1, commit_record.size(), out) != commit_record.size()) {
+    // An empty log has no commit record: fwrite must not get its null data().
+    if (!commit_record.empty() &&
+        std::fwrite(commit_record.data(), 1, commit_record.size(), out) != commit_record.size()) {
       return io_error(s.path, "compact", errno);
     }
     // Lock the new file before it takes the log's name.
