@@ -352,11 +352,11 @@ void ContourStats::add_counts(const ContourStats& s) {
 Result<ContourMesh> contour_world(const World& world, const ContourConfig& config, Context* ctx,
                                   ContourStats* stats) {
   Status s = check_contour_config(config);
-  if (s.ok()) s = check_box_faces_outside(world);
   if (!s.ok()) return s;
   try {
     ScopedTimer timer(ctx, "contour");
     if (!config.chunked) {
+      if (s = check_box_faces_outside(world); !s.ok()) return s;  // chunked: ChunkedMesh::build checks
       ContourStats local;
       Result<ContourMesh> m = contour_one_piece(world, config, local);
       local.seconds = timer.seconds();
