@@ -35,6 +35,10 @@ Status over_load_limit(const std::string& path, uint64_t max_bytes) {
 }  // namespace
 
 Result<std::string> read_file(const std::string& path, uint64_t max_bytes) {
+  return read_file(path, max_bytes, HeadCheck{});
+}
+
+Result<std::string> read_file(const std::string& path, uint64_t max_bytes, const HeadCheck& check_head) {
   // O_NONBLOCK: opening a FIFO with no writer would otherwise wait for one
   // for ever. Only regular files are read (a device such as /dev/zero never
   // ends), and the size is checked before a byte is read.
@@ -62,17 +66,23 @@ Result<std::string> read_file(const std::string& path, uint64_t max_bytes) {
     return io_error(path, "cannot open", error);
   }
   std::string bytes;
-  char buffer[1 << 16];
-  size_t got = 0;
+  std::vector<char> buffer(size_t(1) << 16);
+  size_t got = std::fread(buffer.data(), 1, buffer.size(), file);
+  if (check_head) {
+    if (Status head = check_head(std::string_view(buffer.data(), got), uint64_t(st.st_size)); !head.ok()) {
+      std::fclose(file);
+      return head;
+    }
+  }
   try {
     bytes.reserve(size_t(st.st_size));
     // Still bounded while reading: a file can grow after the fstat.
-    while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) {
+    for (; got > 0; got = std::fread(buffer.data(), 1, buffer.size(), file)) {
       if (bytes.size() + got > max_bytes) {
         std::fclose(file);
         return over_load_limit(path, max_bytes);
       }
-      bytes.append(buffer, got);
+      bytes.append(buffer.data(), got);
     }
   } catch (const std::bad_alloc&) {
     std::fclose(file);

@@ -512,7 +512,12 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
 
 Result<World> load_world(const std::string& path, const LoadLimits& limits, Context* ctx) {
   if (ctx) ctx->report_progress("read", 0.0);
-  Result<std::string> bytes = read_file(path, limits.max_file_bytes);
+  // The header (magic, version, checksum) is checked before the rest is read:
+  // a 300 MB file of zeros was read whole before "bad magic".
+  Result<std::string> bytes = read_file(path, limits.max_file_bytes, [&](std::string_view head, uint64_t) {
+    Header header;
+    return parse_header(head, path, header);
+  });
   if (!bytes.ok()) return bytes.status();
   return deserialize_world(bytes.value(), path, limits, ctx);
 }

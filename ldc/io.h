@@ -28,6 +28,7 @@
 
 #include <cstdint>
 #include <cstdio>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -73,6 +74,12 @@ Result<World> deserialize_world(std::string_view bytes, std::string_view name,
 // FIFO, which would block, or a device such as /dev/zero, which never
 // ends). Errors name the path and the system's reason.
 Result<std::string> read_file(const std::string& path, uint64_t max_bytes = UINT64_MAX);
+// The same, but `check_head` first sees the file's first block (up to 64 KiB,
+// the whole file if smaller) and its size; an error it returns is returned
+// as is, before the rest is read or memory for it reserved (a format's magic:
+// a 2 GB file of zeros named .ply was read whole before the parser refused it).
+using HeadCheck = std::function<Status(std::string_view head, uint64_t file_size)>;
+Result<std::string> read_file(const std::string& path, uint64_t max_bytes, const HeadCheck& check_head);
 
 // Writes `bytes` to `path` so that readers see the old file or the whole
 // new one, never a part: a temp file of a fresh name in the same folder

@@ -822,11 +822,21 @@ Status save_mesh(const TriangleMesh& mesh, const std::string& path, const Export
   return save_mesh(to_contour_mesh(mesh), path, with_material_names(mesh, options));
 }
 
+namespace {
+// The whole file, once its first block looks like `format` (a 300 MB file of
+// zeros named .obj was read whole before the parser found no triangles).
+Result<std::string> read_mesh_file(const std::string& path, MeshFormat format) {
+  return read_file(path, UINT64_MAX, [&](std::string_view head, uint64_t size) {
+    return meshio_detail::check_mesh_file_head(format, head, size, path);
+  });
+}
+}  // namespace
+
 Result<ContourMesh> load_contour_mesh(const std::string& path, const LoadOptions& options) {
   Result<MeshFormat> format = mesh_format_from_path(path);
   if (!format.ok()) return format.status();
   try {
-    Result<std::string> bytes = read_file(path);
+    Result<std::string> bytes = read_mesh_file(path, format.value());
     if (!bytes.ok()) return bytes.status();
     return decode(bytes.value(), format.value(), path, options);
   } catch (const std::bad_alloc&) {
@@ -852,7 +862,7 @@ Result<TriangleMesh> load_mesh(const std::string& path, const LoadOptions& optio
     if (mesh->triangles.empty()) return error_at(ErrorCode::kParseError, path, "no triangles");
     return to_triangle_mesh(mesh.value());
   }
-  Result<std::string> bytes = read_file(path);
+  Result<std::string> bytes = read_mesh_file(path, f);
   if (!bytes.ok()) return bytes.status();
   return parser(bytes.value(), path, options);
 }

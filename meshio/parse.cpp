@@ -6,6 +6,7 @@
 // anything is reserved, polygons are triangulated by one shared ear clipper,
 // and every refusal names the file plus a line (text) or byte offset (binary).
 #include "meshio/meshio.h"
+#include "meshio/detail/codecs.h"
 
 #include <algorithm>
 #include <array>
@@ -1019,28 +1020,33 @@ uint64_t stl_declared_triangles(std::string_view bytes) {
 // Text STL starts with "solid", but so do many binary headers; those are told
 // apart by their exact size, and a truncated binary file by the zero bytes
 // that text never has.
-bool looks_like_text_stl(std::string_view bytes) {
-  if (bytes.size() >= kStlHeaderBytes &&
-      kStlHeaderBytes + kStlTriangleBytes * stl_declared_triangles(bytes) == bytes.size()) {
+// `head` is the file's start (at least its first 1024 bytes, or all of it),
+// `size` the whole file's.
+bool looks_like_text_stl(std::string_view head, uint64_t size) {
+  if (head.size() >= kStlHeaderBytes && size >= kStlHeaderBytes &&
+      kStlHeaderBytes + kStlTriangleBytes * stl_declared_triangles(head) == size) {
     return false;
   }
-  const std::string_view start = trim(bytes.substr(0, 1024));
+  const std::string_view start = trim(head.substr(0, 1024));
   return start.starts_with("solid") && start.find('\0') == std::string_view::npos;
+}
+
+Status binary_stl_size_error(std::string_view head, uint64_t size, std::string_view name) {
+  if (size < kStlHeaderBytes) {
+    return parse_error(concat(name, ": ", size, " bytes is too short for a binary STL and it does not start with 'solid'"));
+  }
+  const uint64_t count = stl_declared_triangles(head);
+  if (kStlHeaderBytes + kStlTriangleBytes * count != size) {
+    return parse_error(concat(name, ": binary STL header declares ", count, " triangles, which take ",
+                              kStlHeaderBytes + kStlTriangleBytes * count, " bytes, but the file has ", size));
+  }
+  return Status();
 }
 
 Result<TriangleMesh> parse_binary_stl(std::string_view bytes, std::string_view name,
                                       const LoadOptions& options) {
-  if (bytes.size() < kStlHeaderBytes) {
-    return parse_error(
-        concat(name, ": ", bytes.size(),
-               " bytes is too short for a binary STL and it does not start with 'solid'"));
-  }
+  if (Status size = binary_stl_size_error(bytes, bytes.size(), name); !size.ok()) return size;
   const uint64_t count = stl_declared_triangles(bytes);
-  if (kStlHeaderBytes + kStlTriangleBytes * count != bytes.size()) {
-    return parse_error(concat(
-        name, ": binary STL header declares ", count, " triangles, which take ",
-        kStlHeaderBytes + kStlTriangleBytes * count, " bytes, but the file has ", bytes.size()));
-  }
   MeshAssembler out(options);
   if (count > options.max_triangles) return out.too_many_triangles(name);
   out.mesh.triangles.reserve(count);
@@ -1310,7 +1316,7 @@ Result<TriangleMesh> parse_ply(std::string_view bytes, std::string_view name,
 Result<TriangleMesh> parse_stl(std::string_view bytes, std::string_view name,
                                const LoadOptions& options) {
   return guarded(bytes, name, options, [&]() -> Result<TriangleMesh> {
-    if (looks_like_text_stl(bytes)) return TextStlParser(name, options).parse(bytes);
+    if (looks_like_text_stl(bytes, bytes.size())) return TextStlParser(name, options).parse(bytes);
     return parse_binary_stl(bytes, name, options);
   });
 }
@@ -1319,5 +1325,39 @@ Result<TriangleMesh> parse_off(std::string_view bytes, std::string_view name,
                                const LoadOptions& options) {
   return guarded(bytes, name, options, [&] { return OffParser(bytes, name, options).parse(); });
 }
+
+namespace meshio_detail {
+
+Status check_mesh_file_head(MeshFormat format, std::string_view head, uint64_t size, std::string_view path) {
+  auto text_only = [&](const char* kind) -> Status {
+    const size_t nul = head.find('\0');
+    if (nul == std::string_view::npos) return Status();
+    return parse_error(concat(path, ": not a text ", kind, " file (a zero byte at offset ", nul, ")"));
+  };
+  switch (format) {
+    case MeshFormat::kObj:
+      return text_only("OBJ");
+    case MeshFormat::kOff:
+      return text_only("OFF");
+    case MeshFormat::kPly: {
+      Tokens tokens(head.substr(0, head.find_first_of("\r\n")));
+      std::string_view keyword;
+      tokens.next(keyword);
+      if (keyword == "ply") return Status();
+      return parse_error(concat(path, ":1: not a PLY file (the first line is not 'ply')"));
+    }
+    case MeshFormat::kStl:
+      return looks_like_text_stl(head, size) ? Status() : binary_stl_size_error(head, size, path);
+    case MeshFormat::kGlb:
+      if (head.starts_with("glTF")) return Status();
+      return parse_error(concat(path, ": not a binary glTF file (it does not start with 'glTF')"));
+    case MeshFormat::kDraco:
+      if (head.starts_with("DRACO")) return Status();
+      return parse_error(concat(path, ": not a Draco file (it does not start with 'DRACO')"));
+  }
+  return Status();
+}
+
+}  // namespace meshio_detail
 
 }  // namespace ldc

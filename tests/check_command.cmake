@@ -1,13 +1,15 @@
 # cmake -DPROGRAM=exe -DARGS="arg1|arg2|..." -DEXIT=<code>|nonzero
 #       [-DSTDOUT_MATCH=regex] [-DSTDERR_MATCH=regex] [-DSTDERR_NO_MATCH=regex]
-#       [-DOUTPUT_FILE=path] [-DNO_OUTPUT_FILE=path|path...] -P check_command.cmake
+#       [-DOUTPUT_FILE=path] [-DNO_OUTPUT_FILE=path|path...] [-DUNCHANGED_FILE=path|path...]
+#       -P check_command.cmake
 # Runs PROGRAM with ARGS ('|' separates them: arguments may hold commas and
 # semicolons would split them in add_test) and passes when the exit status is
 # EXIT (a number, or "nonzero": any exit status > 0, not a crash), stdout and
 # stderr match their regexes (separately, so that a message is known to be on
 # the right stream), stderr does not match STDERR_NO_MATCH, OUTPUT_FILE
 # (removed before the run) exists after it and none of NO_OUTPUT_FILE (removed
-# before the run too: a refused command must not write its output) does.
+# before the run too: a refused command must not write its output) does, and
+# every UNCHANGED_FILE still exists with the bytes it had before the run.
 # CMake regexes have no multi-line mode: ^ and $ are the ends of the whole
 # stream, so a line is anchored with (^|\n) ... (\n|$).
 if(NOT DEFINED PROGRAM OR NOT DEFINED EXIT)
@@ -20,6 +22,12 @@ endif()
 string(REPLACE "|" ";" no_output_files "${NO_OUTPUT_FILE}")
 foreach(f IN LISTS no_output_files)
   file(REMOVE "${f}")
+endforeach()
+string(REPLACE "|" ";" unchanged_files "${UNCHANGED_FILE}")
+set(hashes_before "")
+foreach(f IN LISTS unchanged_files)
+  file(SHA256 "${f}" hash)
+  list(APPEND hashes_before "${hash}")
 endforeach()
 execute_process(COMMAND "${PROGRAM}" ${args} RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message(STATUS "exit status: ${code}\n--- stdout:\n${out}--- stderr:\n${err}---")
@@ -46,6 +54,16 @@ endif()
 foreach(f IN LISTS no_output_files)
   if(EXISTS "${f}")
     string(APPEND failures "${f} was written, which it must not be\n")
+  endif()
+endforeach()
+foreach(f hash_before IN ZIP_LISTS unchanged_files hashes_before)
+  if(NOT EXISTS "${f}")
+    string(APPEND failures "${f} is gone, which it must not be\n")
+  else()
+    file(SHA256 "${f}" hash)
+    if(NOT hash STREQUAL hash_before)
+      string(APPEND failures "${f} was changed, which it must not be\n")
+    endif()
   endif()
 endforeach()
 if(failures)

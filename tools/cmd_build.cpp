@@ -165,7 +165,7 @@ void add_build_command(CLI::App& app, CommonOptions& common) {
   auto args = std::make_shared<BuildArgs>();
   CLI::App* cmd = app.add_subcommand("build", "Build an LDC from a mesh, primitive, heightfield or the landscape");
   cmd->add_option("input", args->input, "Mesh file (.obj .ply .stl .off)");
-  cmd->add_option("-o,--output", args->output, "Output .ldc file")->required();
+  output_file(cmd->add_option("-o,--output", args->output, "Output .ldc file"))->required();
   CLI::Option* cells =
       cmd->add_option("--cells", args->grid.cells, "Cells along the longest axis of the input")->capture_default_str();
   cmd->add_option("--cell-size", args->grid.cell_size, "Cell size h (m); overrides --cells");

@@ -369,13 +369,14 @@ void add_edit_command(CLI::App& app, CommonOptions& common) {
                                              "to a .ldc world or a .ldcs store");
   cmd->add_option("input", args->input, ".ldc file, or a .ldcs store (edited in place, one atomic commit)")->required();
   cmd->add_option("--script", args->script, "JSON edit script (format below)")->required();
-  cmd->add_option("-o,--output", args->output,
-                  "Output .ldc file (written only if every edit succeeds); required for a .ldc input, refused for a store");
+  output_file(cmd->add_option("-o,--output", args->output,
+                              "Output .ldc file (written only if every edit succeeds); required for a .ldc input, "
+                              "refused for a store"));
   cmd->add_flag("--batch", args->batch, "Apply all edits in one apply_batch (one undo step; per-batch counts)");
   cmd->add_flag("--validate", args->validate, "Validate the result; exit 2 and write nothing if invalid");
-  cmd->add_option("--mesh", args->mesh,
-                  "Also contour the world before the edits, re-mesh only what each edit dirtied, and write the "
-                  "mesh here (.obj .ply .stl .glb .drc) with its quality report");
+  output_file(cmd->add_option("--mesh", args->mesh,
+                              "Also contour the world before the edits, re-mesh only what each edit dirtied, and "
+                              "write the mesh here (.obj .ply .stl .glb .drc) with its quality report"));
   cmd->footer(kEditScriptHelp);
   cmd->callback([args, &common] {
     int code = run_edit(*args, common);

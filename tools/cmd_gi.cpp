@@ -321,7 +321,7 @@ void add_gi_command(CLI::App& app, CommonOptions& common) {
   auto args = std::make_shared<GiArgs>();
   CLI::App* cmd = app.add_subcommand("gi", "Image lit by cone-traced global illumination from the voxel cascades -> PNG");
   cmd->add_option("world", args->world, ".ldc file")->required();
-  cmd->add_option("-o,--output", args->output, "Output .png")->required();
+  output_file(cmd->add_option("-o,--output", args->output, "Output .png"))->required();
   add_camera_options(cmd, args->camera, " (default: a view of the whole solid)");
   add_up_option(cmd, args->up, "z (an .ldc world records no up axis)");
   cmd->add_option("--engine", args->engine, "vulkan or cpu")->capture_default_str();

@@ -262,7 +262,7 @@ void add_path_command(CLI::App& app, CommonOptions& common) {
       ->capture_default_str();
   cmd->add_option("--filter", args->filter_file, "Query filter (JSON): per-material costs and exclusions (below)");
   cmd->add_option("--links", args->links_file, "Off-mesh links (JSON): jumps, ladders, teleporters (below)");
-  cmd->add_option("-o,--output", args->output, "Write the path JSON here instead of stdout");
+  output_file(cmd->add_option("-o,--output", args->output, "Write the path JSON here instead of stdout"));
   cmd->footer(std::string(kPathHelp) + kNavFilterHelp);
   cmd->callback([args, &common] {
     int code = run_path(*args, common);

@@ -239,7 +239,7 @@ void add_raycast_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--direction", args->direction, "One ray: its direction x,y,z (any length > 0)");
   cmd->add_option("--max-distance", args->max_distance, "Longest hit distance for --origin and --camera rays (m)");
   add_camera_options(cmd, args->camera, " (one ray per pixel)");
-  cmd->add_option("-o,--output", args->output, "Write the hits here instead of stdout");
+  output_file(cmd->add_option("-o,--output", args->output, "Write the hits here instead of stdout"));
   cmd->footer(kRaycastHelp);
   cmd->callback([args, &common] {
     int code = run_raycast(*args, common);

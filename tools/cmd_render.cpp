@@ -149,7 +149,7 @@ void add_render_command(CLI::App& app, CommonOptions& common) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "Preview image of a world (one ray cast per pixel) -> PNG");
   cmd->add_option("world", args->world, ".ldc file")->required();
-  cmd->add_option("-o,--output", args->output, "Output .png")->required();
+  output_file(cmd->add_option("-o,--output", args->output, "Output .png"))->required();
   add_camera_options(cmd, args->camera, " (default: a view of the whole solid)");
   add_up_option(cmd, args->up, "z (an .ldc world records no up axis)");
   cmd->add_flag("--shadows", args->options.shadows, "Cast a ray toward the sun from each lit hit: shadows");

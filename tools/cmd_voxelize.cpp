@@ -233,7 +233,7 @@ void add_voxelize_command(CLI::App& app, CommonOptions& common) {
   CLI::App* cmd = app.add_subcommand("voxelize", "Solid occupancy and the six-face G-buffer -> .vdb or raw + JSON");
   cmd->footer(kVoxelizeHelp);
   cmd->add_option("world", args->world, "Input .ldc file")->required();
-  cmd->add_option("-o,--output", args->output, "Output .vdb, .json or .raw")->required();
+  output_file(cmd->add_option("-o,--output", args->output, "Output .vdb, .json or .raw"))->required();
   cmd->add_option("--voxel-size", args->voxel_size, "Voxel edge (m): a whole number of cells h")->required();
   cmd->add_option("--cascades", args->cascades, "Camera-centred cascade levels K (0 = one dense grid)");
   cmd->add_option("--resolution", args->resolution, "Voxels per axis of each cascade level")->capture_default_str();

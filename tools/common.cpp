@@ -1,7 +1,9 @@
 #include "common.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <cmath>
@@ -105,6 +107,55 @@ int fail(const std::string& command, const std::string& message) {
   end_progress_line();
   std::fprintf(stderr, "ldc %s: %s\n", command.c_str(), message.c_str());
   return 1;
+}
+
+namespace {
+std::vector<const CLI::Option*>& output_options() {
+  static std::vector<const CLI::Option*> options;
+  return options;
+}
+
+// One file an option names: an existing regular file (what a command reads
+// or would overwrite; a name that does not exist yet clashes with nothing).
+struct NamedFile {
+  dev_t device;
+  ino_t inode;
+  const CLI::Option* option;
+  std::string path;
+};
+
+std::string option_label(const CLI::Option* option) {
+  const std::string name = option->get_name();
+  return name.rfind("--", 0) == 0 ? name : "the " + name + " argument";
+}
+}  // namespace
+
+CLI::Option* output_file(CLI::Option* option) {
+  output_options().push_back(option);
+  return option;
+}
+
+std::string output_clash(const CLI::App& command) {
+  const auto& outputs = output_options();
+  std::vector<NamedFile> files;
+  for (const CLI::Option* option : command.get_options()) {
+    if (option->get_expected_min() == 0) continue;  // a flag
+    for (const std::string& text : option->results()) {
+      struct stat st;
+      if (!text.empty() && ::stat(text.c_str(), &st) == 0 && S_ISREG(st.st_mode))
+        files.push_back({st.st_dev, st.st_ino, option, text});
+    }
+  }
+  for (size_t i = 0; i < files.size(); ++i) {
+    if (std::find(outputs.begin(), outputs.end(), files[i].option) == outputs.end()) continue;
+    for (size_t j = 0; j < files.size(); ++j) {
+      if (j == i || files[j].device != files[i].device || files[j].inode != files[i].inode) continue;
+      return option_label(files[i].option) + " " + files[i].path + " is the file that " +
+             option_label(files[j].option) + " names (" + files[j].path +
+             "): the command would overwrite it; write the output to another file";
+    }
+  }
+  return {};
 }
 
 const char* const kExitStatusHelp =

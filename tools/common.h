@@ -105,6 +105,16 @@ nlohmann::json with_warnings(nlohmann::json report);
 bool warn_if_rasterized_empty(const std::string& command, const World& world, const std::string& input,
                               std::optional<BuildMode> mesh_mode);
 
+// Marks `option` as naming a file the command writes; returns it. Before the
+// command runs, main() refuses a command line where a marked option names
+// the same file (same device and inode, so through links too) as another
+// option of that command: `ldc build model.obj -o model.obj` overwrote the
+// model (issue 24). .ldcs stores are edited in place without -o.
+CLI::Option* output_file(CLI::Option* option);
+// That check for a parsed command: the message naming both options and the
+// file, or empty when no output is also an input or another output.
+std::string output_clash(const CLI::App& command);
+
 // Reading JSON input files: json_inputs.h.
 
 // Whether a path ends in .ldc (any case).

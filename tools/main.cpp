@@ -76,6 +76,11 @@ int main(int argc, char** argv) {
   for (CLI::App* command : app.get_subcommands({})) {  // after a command's own footer, if any
     const std::string own = command->get_footer();
     command->footer(own.empty() ? ldc::tool::kExitStatusHelp : own + "\n" + ldc::tool::kExitStatusHelp);
+    // Runs once the command line is parsed, before the command: no output over an input.
+    command->parse_complete_callback([command] {
+      const std::string clash = ldc::tool::output_clash(*command);
+      if (!clash.empty()) throw CLI::RuntimeError(ldc::tool::fail(command->get_name(), clash));
+    });
   }
   try {
     app.parse(argc, argv);

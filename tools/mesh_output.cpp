@@ -149,7 +149,7 @@ Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report) 
 }
 
 void add_mesh_output_options(CLI::App* cmd, MeshOutputArgs& a) {
-  cmd->add_option("-o,--output", a.output, "Output mesh (.obj .ply .stl .glb .drc)")->required();
+  output_file(cmd->add_option("-o,--output", a.output, "Output mesh (.obj .ply .stl .glb .drc)"))->required();
   cmd->add_option("--method", a.method, "iterative | qef | masspoint | mc")->capture_default_str();
   cmd->add_option("--iterations", a.config.iterations, "Iterative placement: steps")->capture_default_str();
   cmd->add_option("--relax", a.config.relax_iterations, "Material-border relaxation steps (0 = off)")->capture_default_str();

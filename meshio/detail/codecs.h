@@ -14,6 +14,12 @@
 
 namespace ldc::meshio_detail {
 
+// What the first block of a `format` file (`head`: up to 64 KiB, or all of
+// it) must look like, checked before the rest is read (ldc::read_file's
+// HeadCheck): no zero byte in a text format, PLY's first line, binary STL's
+// size from its header, glTF's and Draco's magic. Errors name `path`.
+Status check_mesh_file_head(MeshFormat format, std::string_view head, uint64_t size, std::string_view path);
+
 // triangle_material[t], or 0 when the mesh has no materials.
 inline uint16_t material_of(const ContourMesh& mesh, size_t triangle) {
   return mesh.triangle_material.empty() ? uint16_t{0} : mesh.triangle_material[triangle];
