@@ -116,18 +116,44 @@ Status check_brush(const Brush& b) {
   return std::visit([](const auto& shape) { return check_shape(shape); }, b.shape);
 }
 
-Result<World> rasterize_brush(const Brush& brush, const Lattice& lattice, int chunk_size) {
+namespace {
+
+// The builders' own stages as the one stage "rasterize": an implicit build's
+// "sample", a mesh build's "rasterize" (first half) and "emit" (second half).
+// Their timers stay here; the caller's cancel reaches the build at its next report.
+class BrushProgress {
+ public:
+  explicit BrushProgress(Context* outer) : outer_(outer) {
+    inner_.set_progress([this](std::string_view stage, double fraction) {
+      if (outer_->cancelled()) inner_.cancel();
+      const double f = stage == "sample" ? fraction : stage == "rasterize" ? 0.5 * fraction
+                       : stage == "emit" ? 0.5 + 0.5 * fraction : -1.0;
+      if (f >= 0.0) outer_->report_progress("rasterize", f);
+    });
+  }
+  Context* context() { return outer_ ? &inner_ : nullptr; }
+
+ private:
+  Context* outer_;
+  Context inner_;
+};
+
+}  // namespace
+
+Result<World> rasterize_brush(const Brush& brush, const Lattice& lattice, int chunk_size, Context* ctx) {
   Status s = check_brush(brush);
   if (!s.ok()) return s;
+  BrushProgress progress(ctx);
   if (const Primitive* p = std::get_if<Primitive>(&brush.shape)) {
     Primitive with_material = *p;
     with_material.material = brush.material;
-    return detail::rasterize_primitive(with_material, lattice, chunk_size);
+    return detail::rasterize_primitive(with_material, lattice, chunk_size, progress.context());
   }
   if (const NoiseShape* n = std::get_if<NoiseShape>(&brush.shape)) {
-    return detail::rasterize_noise_sphere(*n, brush.material, lattice, chunk_size);
+    return detail::rasterize_noise_sphere(*n, brush.material, lattice, chunk_size, progress.context());
   }
-  return detail::rasterize_mesh_brush(std::get<MeshShape>(brush.shape), brush.material, lattice, chunk_size);
+  return detail::rasterize_mesh_brush(std::get<MeshShape>(brush.shape), brush.material, lattice, chunk_size,
+                                      progress.context());
 }
 
 }  // namespace ldc

@@ -206,16 +206,17 @@ std::unique_ptr<ImplicitSolid> make_noise_sphere_solid(const NoiseShape& shape, 
   return std::make_unique<NoiseSphereSolid>(shape, material);
 }
 
-Result<World> rasterize_primitive(const Primitive& primitive, const Lattice& lattice, int chunk_size) {
-  return build_from_implicit(*make_primitive_solid(primitive), aligned_grid(lattice, chunk_size));
+Result<World> rasterize_primitive(const Primitive& primitive, const Lattice& lattice, int chunk_size, Context* ctx) {
+  return build_from_implicit(*make_primitive_solid(primitive), aligned_grid(lattice, chunk_size), ctx);
 }
 
 Result<World> rasterize_noise_sphere(const NoiseShape& shape, uint16_t material, const Lattice& lattice,
-                                    int chunk_size) {
-  return build_from_implicit(NoiseSphereSolid(shape, material), aligned_grid(lattice, chunk_size));
+                                    int chunk_size, Context* ctx) {
+  return build_from_implicit(NoiseSphereSolid(shape, material), aligned_grid(lattice, chunk_size), ctx);
 }
 
-Result<World> rasterize_mesh_brush(const MeshShape& shape, uint16_t material, const Lattice& lattice, int chunk_size) {
+Result<World> rasterize_mesh_brush(const MeshShape& shape, uint16_t material, const Lattice& lattice, int chunk_size,
+                                  Context* ctx) {
   TriangleMesh placed;
   placed.positions.reserve(shape.mesh->positions.size());
   for (const glm::dvec3& p : shape.mesh->positions) {
@@ -226,7 +227,7 @@ Result<World> rasterize_mesh_brush(const MeshShape& shape, uint16_t material, co
     for (glm::uvec3& t : placed.triangles) std::swap(t.y, t.z);
   }
   placed.triangle_material.assign(placed.triangles.size(), material);
-  return build_from_mesh(placed, aligned_grid(lattice, chunk_size));
+  return build_from_mesh(placed, aligned_grid(lattice, chunk_size), ctx);
 }
 
 }  // namespace ldc::detail

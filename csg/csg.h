@@ -153,8 +153,10 @@ Status check_brush(const Brush& brush);
 // Primitives and noise spheres are built like implicit solids (node signs
 // sampled; primitives get exact analytic crossings), meshes by the watertight
 // mesh builder (open or self-intersecting brush meshes are repaired). Every
-// point takes the brush's material.
-Result<World> rasterize_brush(const Brush& brush, const Lattice& lattice, int chunk_size);
+// point takes the brush's material. `ctx` (optional) gets its progress as one
+// stage, "rasterize" from 0 to 1 (a 300 m brush takes minutes), and may
+// cancel it (kCancelled).
+Result<World> rasterize_brush(const Brush& brush, const Lattice& lattice, int chunk_size, Context* ctx = nullptr);
 
 enum class EditOp {
   kUnion,      // world union brush (build)

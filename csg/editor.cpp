@@ -58,8 +58,9 @@ struct PreparedEdit {
   bool empty = true;                                // the brush holds no solid on this lattice
 };
 
-Result<PreparedEdit> prepare_edit(const WorldEditor::Edit& e, const World& world) {
-  Result<World> raster = rasterize_brush(e.brush, world.lattice(), world.chunk_size());
+// ctx: the brush's own progress and cancellation (one edit at a time only).
+Result<PreparedEdit> prepare_edit(const WorldEditor::Edit& e, const World& world, Context* ctx) {
+  Result<World> raster = rasterize_brush(e.brush, world.lattice(), world.chunk_size(), ctx);
   if (!raster.ok()) return raster.status();
   PreparedEdit p;
   p.brush = std::move(raster).value();
@@ -178,14 +179,19 @@ Result<EditReceipt> WorldEditor::apply_batch(std::span<const Edit> edits, Contex
   if (!s.ok()) return s;
   // Rasterize every brush first: any error leaves the world untouched.
   // Reported from the start (issue 24: a large brush rasterized for minutes
-  // with nothing shown); rasterize_brush itself reports nothing inside one brush.
+  // with nothing shown): one brush reports its own progress, several a step each.
   std::vector<Result<PreparedEdit>> prepared_or(edits.size(), Status(ErrorCode::kInternal, "not run"));
   if (ctx) ctx->report_progress("rasterize", 0.0);
-  detail::ProgressCounter rasterized(ctx, "rasterize", edits.size());
-  tbb::parallel_for(size_t{0}, edits.size(), [&](size_t i) {
-    prepared_or[i] = prepare_edit(edits[i], world_);
-    rasterized.step();
-  });
+  if (edits.size() == 1) {
+    prepared_or[0] = prepare_edit(edits[0], world_, ctx);
+  } else {
+    detail::ProgressCounter rasterized(ctx, "rasterize", edits.size());
+    tbb::parallel_for(size_t{0}, edits.size(), [&](size_t i) {
+      prepared_or[i] = prepare_edit(edits[i], world_, nullptr);
+      rasterized.step();
+    });
+  }
+  if (ctx && ctx->cancelled()) return detail::cancelled_status("edit");
   std::vector<PreparedEdit> prepared;
   prepared.reserve(edits.size());
   for (size_t i = 0; i < edits.size(); ++i) {

@@ -204,5 +204,46 @@ TEST(HostileLoad, AnEditReportsRasterizingBeforeAnythingElse) {
   EXPECT_EQ(reports.back(), (Reports::value_type{"edit", 1.0}));
 }
 
+// Issue 24 finding 10: one large brush reported nothing while it was
+// rasterized (a 300 m sphere: minutes at 0%). Its build's progress is now the
+// edit's "rasterize" stage, many reports between 0 and 1, before "edit".
+World small_ground() {
+  Primitive slab{.shape = Primitive::Shape::kBox, .half_extents = {4.0, 4.0, 1.0}};
+  return build_from_primitive(slab, {.cell_size = 0.25, .chunk_size = 8}).value();
+}
+
+TEST(HostileLoad, OneLargeBrushReportsItsRasterizationAsItGoes) {
+  WorldEditor editor(small_ground());
+  Context ctx;
+  Reports reports;
+  record_progress(ctx, reports);
+  ASSERT_TRUE(editor.apply(Brush::sphere({0, 0, 0}, 12.0), EditOp::kUnion, &ctx).ok());
+  size_t within = 0, first_edit = reports.size(), last_rasterize = 0;
+  for (size_t i = 0; i < reports.size(); ++i) {
+    if (reports[i].first == "rasterize") {
+      last_rasterize = i;
+      within += reports[i].second > 0.0 && reports[i].second < 1.0;
+    }
+    if (reports[i].first == "edit" && first_edit == reports.size()) first_edit = i;
+  }
+  EXPECT_GE(within, 10u) << "the brush's rasterization reported no fraction between 0 and 1";
+  EXPECT_LT(last_rasterize, first_edit);
+  EXPECT_TRUE(validate(editor.world()).ok);
+}
+
+TEST(HostileLoad, CancellingDuringOneBrushLeavesTheWorldAsItWas) {
+  WorldEditor editor(small_ground());
+  const size_t points = editor.world().stats().points;
+  Context ctx;
+  ctx.set_progress([&ctx](std::string_view stage, double f) {
+    if (stage == "rasterize" && f > 0.1 && f < 1.0) ctx.cancel();  // within the one brush
+  });
+  Result<EditReceipt> r = editor.apply(Brush::sphere({0, 0, 0}, 12.0), EditOp::kUnion, &ctx);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kCancelled) << r.status().message();
+  EXPECT_EQ(editor.world().stats().points, points);
+  EXPECT_TRUE(editor.take_dirty().empty());
+}
+
 }  // namespace
 }  // namespace ldc

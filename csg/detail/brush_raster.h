@@ -9,9 +9,11 @@ namespace ldc::detail {
 // one cell of padding around the input.
 GridConfig aligned_grid(const Lattice& lattice, int chunk_size);
 
-Result<World> rasterize_primitive(const Primitive& primitive, const Lattice& lattice, int chunk_size);
-Result<World> rasterize_noise_sphere(const NoiseShape& shape, uint16_t material, const Lattice& lattice, int chunk_size);
-Result<World> rasterize_mesh_brush(const MeshShape& shape, uint16_t material, const Lattice& lattice, int chunk_size);
+Result<World> rasterize_primitive(const Primitive& primitive, const Lattice& lattice, int chunk_size, Context* ctx = nullptr);
+Result<World> rasterize_noise_sphere(const NoiseShape& shape, uint16_t material, const Lattice& lattice, int chunk_size,
+                                    Context* ctx = nullptr);
+Result<World> rasterize_mesh_brush(const MeshShape& shape, uint16_t material, const Lattice& lattice, int chunk_size,
+                                  Context* ctx = nullptr);
 
 // The noise sphere as an implicit solid (for tests and the rasterizer).
 std::unique_ptr<ImplicitSolid> make_noise_sphere_solid(const NoiseShape& shape, uint16_t material = 0);
