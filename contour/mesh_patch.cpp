@@ -108,19 +108,32 @@ void patch_box(const glm::ivec3& node_lo, const glm::ivec3& node_hi, int reach, 
   *hi = node_hi + reach + 1;
 }
 
+// The axis to cut a patch along: the longest, x or y before z on a tie. A
+// landscape's surface is a horizontal band, so slabs along z gave one thread
+// nearly all of a dig's surface; cuts across x or y share it out.
+int slab_axis(const glm::ivec3& size) {
+  int axis = 1;
+  if (size.x > size[axis]) axis = 0;
+  if (size.z > size[axis]) axis = 2;
+  return axis;
+}
+
 MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm::ivec3& lo, const glm::ivec3& hi,
                      ContourStats& stats) {
-  // Slabs along z, one per thread (each re-reads a margin, so no more than that).
-  const int depth = hi.z - lo.z;
+  // Slabs along one axis, one per thread (each re-reads a margin, so no more than that).
+  const glm::ivec3 size = hi - lo;
+  const int axis = slab_axis(size);
+  const int depth = size[axis];
   const int slabs = std::max(1, std::min(tbb::this_task_arena::max_concurrency(), depth / 8));
   std::vector<ChunkMesh> pieces(static_cast<size_t>(slabs));
   std::vector<ContourStats> piece_stats(static_cast<size_t>(slabs));
-  const glm::ivec3 size = hi - lo;
-  const bool small = size_t(size.x) * size_t(size.y) * size_t(depth / slabs + 1) <= kKeptMesherCells;
+  glm::ivec3 slab_size = size;
+  slab_size[axis] = depth / slabs + 1;
+  const bool small = size_t(slab_size.x) * size_t(slab_size.y) * size_t(slab_size.z) <= kKeptMesherCells;
   tbb::parallel_for(0, slabs, [&](int s) {
     glm::ivec3 a = lo, b = hi;
-    a.z = lo.z + depth * s / slabs;
-    b.z = lo.z + depth * (s + 1) / slabs;
+    a[axis] = lo[axis] + depth * s / slabs;
+    b[axis] = lo[axis] + depth * (s + 1) / slabs;
     if (small) {
       kept_mesher(world, config).mesh(a, b, pieces[size_t(s)], piece_stats[size_t(s)], /*order_triangles=*/false);
     } else {
@@ -130,15 +143,31 @@ MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm:
   MeshPatch p;
   p.lo = lo;
   p.hi = hi;
-  for (size_t s = 0; s < pieces.size(); ++s) {  // slabs in z order keep the cells sorted
-    const ChunkMesh& m = pieces[s];
-    for (size_t v = 0; v < m.own_vertices; ++v) {
-      p.cells.push_back(m.vertex_cell[v]);
-      p.sheets.push_back(m.vertex_sheet[v]);
-      p.positions.push_back(m.mesh.positions[v]);
-      p.normals.push_back(m.mesh.normals[v]);
-      p.materials.push_back(m.mesh.vertex_material[v]);
+  // Each slab's own vertices are sorted by cell then sheet: merged, they are
+  // the patch's (slabs along z simply follow each other).
+  std::vector<size_t> next(pieces.size(), 0);
+  for (;;) {
+    size_t best = pieces.size();
+    for (size_t s = 0; s < pieces.size(); ++s) {
+      const ChunkMesh& m = pieces[s];
+      if (next[s] == m.own_vertices) continue;
+      const ChunkMesh* b = best < pieces.size() ? &pieces[best] : nullptr;
+      if (!b || vertex_less(m.vertex_cell[next[s]], m.vertex_sheet[next[s]], b->vertex_cell[next[best]],
+                            b->vertex_sheet[next[best]])) {
+        best = s;
+      }
     }
+    if (best == pieces.size()) break;
+    const ChunkMesh& m = pieces[best];
+    const size_t v = next[best]++;
+    p.cells.push_back(m.vertex_cell[v]);
+    p.sheets.push_back(m.vertex_sheet[v]);
+    p.positions.push_back(m.mesh.positions[v]);
+    p.normals.push_back(m.mesh.normals[v]);
+    p.materials.push_back(m.mesh.vertex_material[v]);
+  }
+  for (size_t s = 0; s < pieces.size(); ++s) {
+    const ChunkMesh& m = pieces[s];
     for (size_t t = 0; t < m.mesh.triangles.size(); ++t) {
       const glm::uvec3& tri = m.mesh.triangles[t];
       p.triangles.push_back({{m.vertex_cell[tri.x], m.vertex_cell[tri.y], m.vertex_cell[tri.z]},
@@ -152,24 +181,11 @@ MeshPatch mesh_patch(const World& world, const ContourConfig& config, const glm:
 
 ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::ivec3& chunk, int chunk_size) {
   const glm::ivec3 own_lo = chunk * chunk_size, own_hi = own_lo + chunk_size;
-  // Triangles: the old ones on edges outside the patch, the patch's on edges this chunk owns.
   // Scratch kept per thread: fresh large vectors would fault in new pages on
   // every splice (mmap'ed by malloc), which cost more than filling them.
-  thread_local std::vector<MeshPatch::Triangle> tris;
   thread_local std::vector<VertexSource> sources;
-  tris.clear();
+  thread_local std::vector<int32_t> old_to_new;
   sources.clear();
-  for (size_t t = 0; t < old.mesh.triangles.size(); ++t) {
-    const glm::uvec3& i = old.mesh.triangles[t];
-    const glm::ivec3 cells[3] = {old.vertex_cell[i.x], old.vertex_cell[i.y], old.vertex_cell[i.z]};
-    if (in_box(edge_node(cells), patch.lo, patch.hi)) continue;
-    tris.push_back({{cells[0], cells[1], cells[2]},
-                    {old.vertex_sheet[i.x], old.vertex_sheet[i.y], old.vertex_sheet[i.z]},
-                    old.mesh.triangle_material[t]});
-  }
-  for (const MeshPatch::Triangle& tri : patch.triangles) {
-    if (in_box(edge_node(tri.cell), own_lo, own_hi)) tris.push_back(tri);
-  }
   // Own vertices, sorted: the old ones outside the patch merged with the patch's in this chunk.
   auto patch_begin = std::lower_bound(patch.cells.begin(), patch.cells.end(), own_lo, cell_less);
   size_t p = size_t(patch_begin - patch.cells.begin());
@@ -205,29 +221,46 @@ ChunkMesh splice_patch(const ChunkMesh& old, const MeshPatch& patch, const glm::
   for (size_t v = old.own_vertices; v < old.vertex_cell.size(); ++v) {
     if (old_index.contains(old.vertex_cell[v])) old_index.set(old.vertex_cell[v], old.vertex_sheet[v], int32_t(v));
   }
+  // The spliced mesh's index of a vertex, a copy added on its first use:
+  // from the patch inside its box, else from the old mesh.
+  auto vertex_id = [&](const glm::ivec3& cell, uint8_t sheet) -> uint32_t {
+    int32_t id = index.get(cell, sheet);
+    if (id >= 0) return uint32_t(id);
+    id = int32_t(sources.size());
+    index.set(cell, sheet, id);
+    if (in_box(cell, patch.lo, patch.hi)) {
+      auto it = std::lower_bound(patch.cells.begin(), patch.cells.end(), cell, cell_less);
+      sources.push_back({cell, sheet, true, size_t(it - patch.cells.begin()) + sheet});
+    } else {
+      sources.push_back({cell, sheet, false, size_t(old_index.get(cell, sheet))});
+    }
+    return uint32_t(id);
+  };
   ChunkMesh out;
   out.chunk = chunk;
-  out.mesh.triangles.reserve(tris.size());
-  out.mesh.triangle_material.reserve(tris.size());
-  for (const MeshPatch::Triangle& tri : tris) {
+  out.mesh.triangles.reserve(old.mesh.triangles.size() + patch.triangles.size() / 4);
+  out.mesh.triangle_material.reserve(out.mesh.triangles.capacity());
+  // Triangles: the old ones on edges outside the patch (an old vertex's new
+  // index looked up once, however many triangles share it), then the
+  // patch's on edges this chunk owns.
+  old_to_new.assign(old.vertex_cell.size(), -1);
+  for (size_t t = 0; t < old.mesh.triangles.size(); ++t) {
+    const glm::uvec3& i = old.mesh.triangles[t];
+    const glm::ivec3 cells[3] = {old.vertex_cell[i.x], old.vertex_cell[i.y], old.vertex_cell[i.z]};
+    if (in_box(edge_node(cells), patch.lo, patch.hi)) continue;
     glm::uvec3 ids;
     for (int j = 0; j < 3; ++j) {
-      const glm::ivec3& cell = tri.cell[j];
-      const uint8_t sheet = tri.sheet[j];
-      int32_t id = index.get(cell, sheet);
-      if (id < 0) {
-        id = int32_t(sources.size());
-        index.set(cell, sheet, id);
-        if (in_box(cell, patch.lo, patch.hi)) {
-          auto it = std::lower_bound(patch.cells.begin(), patch.cells.end(), cell, cell_less);
-          sources.push_back({cell, sheet, true, size_t(it - patch.cells.begin()) + sheet});
-        } else {
-          sources.push_back({cell, sheet, false, size_t(old_index.get(cell, sheet))});
-        }
-      }
+      int32_t& id = old_to_new[i[j]];
+      if (id < 0) id = int32_t(vertex_id(cells[j], old.vertex_sheet[i[j]]));
       ids[j] = uint32_t(id);
     }
     out.mesh.triangles.push_back(ids);
+    out.mesh.triangle_material.push_back(old.mesh.triangle_material[t]);
+  }
+  for (const MeshPatch::Triangle& tri : patch.triangles) {
+    if (!in_box(edge_node(tri.cell), own_lo, own_hi)) continue;
+    out.mesh.triangles.push_back(
+        {vertex_id(tri.cell[0], tri.sheet[0]), vertex_id(tri.cell[1], tri.sheet[1]), vertex_id(tri.cell[2], tri.sheet[2])});
     out.mesh.triangle_material.push_back(tri.material);
   }
   out.own_vertices = own;
