@@ -5,6 +5,7 @@
 #include "common.h"
 #include "csg/csg.h"
 #include "ldc/io.h"
+#include "ldc/lod.h"
 #include "mesh_output.h"
 #include "meshio/meshio.h"
 
@@ -16,7 +17,18 @@ struct ContourArgs {
   MeshOutputArgs mesh;
   GridConfig grid;  // remesh only
   std::string region;  // contour of a .ldcs store only: X0,Y0,Z0,X1,Y1,Z1 (m)
+  int lod = 0;         // contour only: every 2^lod-th ray (ldc/lod.h)
 };
+
+// The world at level a.lod (itself at 0), the seconds it took under "coarsen".
+Result<World> at_level(World world, int lod, nlohmann::json& report) {
+  if (lod == 0) return world;
+  ScopedTimer t(nullptr, "");
+  Result<World> coarse = coarsen(world, lod);
+  report["seconds"]["coarsen"] = t.seconds();
+  report["lod"] = lod;
+  return coarse;
+}
 
 // Cuts the window's solid down to the region's box (an intersect edit), so
 // that it no longer reaches the window's faces, where contouring needs
@@ -71,6 +83,8 @@ int run_store_contour(const ContourArgs& a, const CommonOptions& common) {
   nlohmann::json report = {{"seconds", {{"page", page}, {"cut", c.seconds()}}},
                            {"region", range_json(layout, range.value())},
                            {"chunks_paged", paged.stats().page_ins}};
+  w = at_level(std::move(w).value(), a.lod, report);
+  if (!w.ok()) return fail("contour", w.status());
   return contour_and_report("contour", w.value(), a.mesh, bar, std::move(report), common,
                             [](const nlohmann::json& r) {
                               std::printf("  region %s, %zu chunks paged\n", range_text(r["region"]).c_str(),
@@ -88,7 +102,10 @@ int run_contour(const ContourArgs& a, const CommonOptions& common) {
   ScopedTimer t(nullptr, "");
   Result<World> w = load_world(a.input, {}, bar.context());
   if (!w.ok()) return fail("contour", w.status());
-  return contour_and_report("contour", w.value(), a.mesh, bar, {{"seconds", {{"load", t.seconds()}}}}, common);
+  nlohmann::json report = {{"seconds", {{"load", t.seconds()}}}};
+  w = at_level(std::move(w).value(), a.lod, report);
+  if (!w.ok()) return fail("contour", w.status());
+  return contour_and_report("contour", w.value(), a.mesh, bar, std::move(report), common);
 }
 
 int run_remesh(const ContourArgs& a, const CommonOptions& common) {
@@ -119,6 +136,11 @@ void add_contour_commands(CLI::App& app, CommonOptions& common) {
   contour->add_option("--region", c->region,
                       "A .ldcs store's box X0,Y0,Z0,X1,Y1,Z1 (m): the chunks it meets are paged in and contoured "
                       "as a world of their own (closed at the box's faces)");
+  contour->add_option("--lod", c->lod,
+                      "Level of detail K: contour every 2^K-th ray (cells 2^K h; 0 = full detail, at most 1, 2, 3 "
+                      "for chunks of 16, 32, 64 cells)")
+      ->check(CLI::Range(0, 3))
+      ->capture_default_str();
   contour->callback([c, &common] {
     int code = run_contour(*c, common);
     if (code != 0) throw CLI::RuntimeError(code);
