@@ -175,6 +175,11 @@ Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk, con
                                 ContourStats* stats) {
   Status s = check_contour_config(config);
   if (!s.ok()) return s;
+  // The face chunks of the world's box within the chunk's reach (a window cut
+  // through the ground crashed the mesher there): cells read reach past the
+  // placement reach by the quads' and sheets' cells and the load margin.
+  const int c = world.chunk_size(), reach = detail::RegionMesher::vertex_reach(config) + 4;
+  if (s = check_box_faces_outside(world, chunk * c - reach, (chunk + 1) * c + reach); !s.ok()) return s;
   ContourStats local;
   Result<std::vector<ChunkMesh>> r = mesh_chunks(world, {chunk}, config, nullptr, local);
   if (stats) stats->add_counts(local);

@@ -317,12 +317,25 @@ Status check_face_chunk(const World& w, const glm::ivec3& ch, int a, bool high) 
 }  // namespace
 
 Status check_box_faces_outside(const World& w) {
-  const glm::ivec3 lo = w.chunk_origin(), hi = lo + w.chunk_dims();
+  return check_box_faces_outside(w, w.node_min(), w.node_end());
+}
+
+Status check_box_faces_outside(const World& w, const glm::ivec3& node_lo, const glm::ivec3& node_hi) {
+  const glm::ivec3 box_lo = w.chunk_origin(), box_hi = box_lo + w.chunk_dims();
+  // The chunks the node range meets, within the box.
+  glm::ivec3 lo, hi;
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::max(box_lo[a], detail::floor_div(node_lo[a], w.chunk_size()));
+    hi[a] = std::min(box_hi[a], detail::floor_div(node_hi[a] - 1, w.chunk_size()) + 1);
+  }
+  if (glm::any(glm::greaterThanEqual(lo, hi))) return {};
   for (int a = 0; a < 3; ++a) {
     const int u = axis_u(a), v = axis_v(a);
     for (const bool high : {false, true}) {
+      // Only a face the range reaches: a cut deeper in the face chunk is not read.
+      if (high ? node_hi[a] < w.node_end()[a] : node_lo[a] > w.node_min()[a]) continue;
       glm::ivec3 ch;
-      ch[a] = high ? hi[a] - 1 : lo[a];
+      ch[a] = high ? box_hi[a] - 1 : box_lo[a];
       for (ch[v] = lo[v]; ch[v] < hi[v]; ++ch[v])
         for (ch[u] = lo[u]; ch[u] < hi[u]; ++ch[u])
           if (Status s = check_face_chunk(w, ch, a, high); !s.ok()) return s;

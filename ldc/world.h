@@ -383,6 +383,11 @@ ValidationReport validate(const World& world, const ValidateOptions& options = {
 // face are allowed (they mesh to nothing there). kInvalidArgument names the
 // first face chunk and ray.
 Status check_box_faces_outside(const World& world);
+// The same for the part of the box faces that lattice nodes [node_lo,
+// node_hi) (exclusive) reach: what meshing part of a world reads
+// (contour_chunk: one chunk and its reach). A face the range stops short of
+// is not checked.
+Status check_box_faces_outside(const World& world, const glm::ivec3& node_lo, const glm::ivec3& node_hi);
 
 // Checks the invariants local to one chunk (everything but cross-chunk
 // continuity). Used by the file loader on each chunk it reads.

@@ -8,6 +8,8 @@
 #include "contour/contour.h"
 #include "ldc/build.h"
 #include "ldc/lod.h"
+#include "ldc/store.h"
+#include "ldc/terrain.h"
 #include "test_util.h"
 
 namespace ldc {
@@ -92,5 +94,55 @@ TEST(Lod, EachLevelMeshesClosedWithAQuarterOfTheTriangles) {
   }
 }
 
+// Chunk by chunk (the bake's way): every chunk mesh of a coarse landscape
+// indexes its own vertices only.
+TEST(Lod, EveryChunkMeshOfACoarseLandscapeIsWellFormed) {
+  TerrainConfig t;
+  t.size_x = t.size_y = 64.0;
+  const World w = build_terrain(t, 0.5, 32).value();
+  for (int level : {1, 2}) {
+    const World coarse = coarsen(w, level).value();
+    coarse.for_each_chunk([&](const glm::ivec3& c, ChunkKind, const Chunk*) {
+      Result<ChunkMesh> m = contour_chunk(coarse, c);
+      ASSERT_TRUE(m.ok()) << m.status().message();
+      for (const glm::uvec3& tri : m.value().mesh.triangles)
+        for (int j = 0; j < 3; ++j)
+          ASSERT_LT(tri[j], m.value().mesh.positions.size()) << "level " << level << " chunk " << c.x << "," << c.y << "," << c.z;
+    });
+  }
+}
+
+// The bake's way: a window of a column and enough chunks around it (one,
+// two where coarse chunks have 8 cells), paged from the procedural source,
+// coarsened, then the column's chunks one by one. A chunk whose reach meets
+// the window's faces (cut through the ground) is refused, naming the face:
+// it crashed the mesher (an index past the vertices).
+TEST(Lod, ChunkMeshesOfACoarseWindowAreWellFormedAndItsFacesAreRefused) {
+  TerrainConfig t;
+  t.size_x = t.size_y = 64.0;
+  auto source = make_terrain_source(t, 0.5, 32).value();
+  PagedWorld paged(source);
+  const SourceLayout layout = paged.layout();
+  const int z0 = layout.box.chunk_origin.z, z1 = z0 + layout.box.chunk_dims.z;
+  for (int level : {0, 1, 2}) {
+    const int margin = (32 >> level) >= 16 ? 1 : 2;
+    for (const glm::ivec2 column : {glm::ivec2(1, 1), glm::ivec2(2, 0), glm::ivec2(3, 2)}) {
+      const glm::ivec3 lo(column.x - margin, column.y - margin, z0), hi(column.x + margin + 1, column.y + margin + 1, z1);
+      const World coarse = coarsen(paged.window(lo, hi).value(), level).value();
+      for (int z = z0; z < z1; ++z) {
+        Result<ChunkMesh> m = contour_chunk(coarse, glm::ivec3(column, z));
+        ASSERT_TRUE(m.ok()) << "level " << level << ": " << m.status().message();
+        for (const glm::uvec3& tri : m.value().mesh.triangles)
+          for (int j = 0; j < 3; ++j) ASSERT_LT(tri[j], m.value().mesh.positions.size()) << "level " << level;
+      }
+    }
+    // A window of chunks 1 and 2 along x and y: both faces cut the ground.
+    const World cut = coarsen(paged.window(glm::ivec3(1, 1, z0), glm::ivec3(3, 3, z1)).value(), level).value();
+    Result<ChunkMesh> face = contour_chunk(cut, glm::ivec3(1, 1, 0));
+    ASSERT_FALSE(face.ok()) << "level " << level;
+    EXPECT_EQ(face.status().code(), ErrorCode::kInvalidArgument);
+    EXPECT_NE(face.status().message().find("inside at the world box face"), std::string::npos) << face.status().message();
+  }
+}
 }  // namespace
 }  // namespace ldc

@@ -1,7 +1,7 @@
 // ldc bake (issue 23): the offline bake of a large world, sharded for a batch
 // scheduler (a Slurm job array, a Kubernetes Indexed Job), and its merge.
 //
-//   ldc bake WORLD --out DIR --shard i/N [--products mesh,nav,voxels] [--lods 1]
+//   ldc bake WORLD --out DIR --shard i/N [--products mesh,nav,voxels] [--lods N]
 //   ldc bake --merge DIR
 //
 // Work units are chunk columns (x, y) holding at least one chunk that may be
@@ -20,9 +20,11 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -33,6 +35,7 @@
 #include "contour/contour.h"
 #include "ldc/internal/crc32.h"
 #include "ldc/io.h"
+#include "ldc/lod.h"
 #include "ldc/store.h"
 #include "meshio/meshio.h"
 #include "nav/nav.h"
@@ -293,17 +296,115 @@ Status write_product(const fs::path& dir, const std::string& name, const std::st
   return Status();
 }
 
-UnitResult bake_unit(const Unit& u, PagedWorld& paged, std::mutex& paged_mutex, const Products& p, const fs::path& dir) {
+// The unit's column and `margin` chunk columns around it, the whole z range.
+using WindowFn = std::function<Result<World>(int margin)>;
+
+// Each chunk of the unit's column as a mesh, at level 0 ("mesh/<chunk>.glb")
+// and at levels 1 .. lods - 1 ("mesh/lod<k>/<chunk>.glb", from the window
+// coarsened to every 2^k-th ray: ldc/lod.h). A chunk's mesh reads about ten
+// cells around it, so coarse chunks of 8 cells take a window of two chunk
+// columns around the unit (contour_chunk refuses a reach into a cut face).
+// Empty meshes write no file.
+Status bake_meshes(const World& w, const WindowFn& window, const Unit& u, int z0, int z1, int lods,
+                   const fs::path& dir, UnitResult& r) {
+  for (int level = 0; level < lods; ++level) {
+    std::optional<World> coarse;
+    if (level > 0) {
+      std::optional<World> wide;
+      if ((w.chunk_size() >> level) < 16) {
+        Result<World> two = window(2);
+        if (!two.ok()) return two.status();
+        wide = std::move(two).value();
+      }
+      Result<World> made = coarsen(wide ? *wide : w, level);
+      if (!made.ok()) return made.status();
+      coarse = std::move(made).value();
+    }
+    const World& at_level = coarse ? *coarse : w;
+    const std::string folder = level == 0 ? "mesh/" : "mesh/lod" + std::to_string(level) + "/";
+    for (int z = z0; z < z1; ++z) {
+      const glm::ivec3 c(u.column, z);
+      Result<ChunkMesh> m = contour_chunk(at_level, c);
+      if (!m.ok()) return m.status();
+      if (m.value().mesh.triangles.empty()) continue;
+      const std::string name = folder + chunk_name(c) + ".glb";
+      // save_mesh writes atomically; its bytes are read back for the checksum.
+      if (Status s = save_mesh(m.value().mesh, (dir / name).string()); !s.ok()) return s;
+      Result<std::string> bytes = read_file((dir / name).string());
+      if (!bytes.ok()) return bytes.status();
+      r.files.push_back({name, bytes.value().size(), crc_of(bytes.value())});
+      r.bytes[0] += bytes.value().size();
+    }
+  }
+  return Status();
+}
+
+// Each mixed chunk's walkable-floor heights, one float per ray column (NaN
+// where none), from a nav mesh of the window: "nav/<chunk>.nav".
+Status bake_nav(const World& w, const Unit& u, int z0, int z1, const SourceLayout& layout, const fs::path& dir,
+                UnitResult& r) {
+  const int C = layout.chunk_size;
+  const double h = layout.lattice.cell_size;
+  Result<NavMesh> nav = NavMesh::build(w, NavConfig{});
+  if (!nav.ok()) return nav.status();
+  NavQuery query(nav.value());
+  for (int z = z0; z < z1; ++z) {
+    const glm::ivec3 c(u.column, z);
+    if (w.chunk_kind(c) != ChunkKind::kMixed) continue;
+    std::vector<float> heights(size_t(C) * C, std::nanf(""));
+    bool any = false;
+    const double zmid = layout.lattice.node_position(glm::ivec3(0, 0, z * C)).z + 0.5 * C * h;
+    for (int v = 0; v < C; ++v)
+      for (int uu = 0; uu < C; ++uu) {
+        glm::dvec3 pos = layout.lattice.node_position(glm::ivec3(c.x * C + uu, c.y * C + v, z * C));
+        pos.z = zmid;
+        Result<NavPoint> np = query.nearest_walkable(pos, glm::dvec3(0.49 * h, 0.49 * h, 0.5 * C * h));
+        if (np.ok()) {
+          heights[size_t(v) * C + uu] = float(np.value().position.z);
+          any = true;
+        }
+      }
+    if (!any) continue;
+    std::string bytes(heights.size() * sizeof(float), '\0');
+    std::memcpy(bytes.data(), heights.data(), bytes.size());
+    if (Status s = write_product(dir, "nav/" + chunk_name(c) + ".nav", bytes, r, 1); !s.ok()) return s;
+  }
+  return Status();
+}
+
+// Each mixed chunk's solid occupancy in 2h bricks, a byte each: "voxels/<chunk>.occ".
+Status bake_voxels(const World& w, const Unit& u, int z0, int z1, const SourceLayout& layout, const fs::path& dir,
+                   UnitResult& r) {
+  VoxelConfig config;
+  config.voxel_size = 2.0 * layout.lattice.cell_size;
+  const int n = layout.chunk_size / 2;
+  for (int z = z0; z < z1; ++z) {
+    const glm::ivec3 c(u.column, z);
+    if (w.chunk_kind(c) != ChunkKind::kMixed) continue;
+    VoxelizeOptions options;
+    options.box = VoxelBox{c * n, glm::ivec3(n)};
+    Result<VoxelGrid> grid = voxelize(w, config, options);
+    if (!grid.ok()) return grid.status();
+    std::string bytes(grid.value().occupancy.size(), '\0');
+    for (size_t i = 0; i < bytes.size(); ++i)
+      bytes[i] = char(uint8_t(std::lround(std::clamp(grid.value().occupancy[i], 0.0f, 1.0f) * 255.0f)));
+    if (Status s = write_product(dir, "voxels/" + chunk_name(c) + ".occ", bytes, r, 2); !s.ok()) return s;
+  }
+  return Status();
+}
+
+UnitResult bake_unit(const Unit& u, PagedWorld& paged, std::mutex& paged_mutex, const Products& p, int lods,
+                     const fs::path& dir) {
   UnitResult r;
   const SourceLayout layout = paged.layout();
   const int z0 = layout.box.chunk_origin.z, z1 = z0 + layout.box.chunk_dims.z;
-  const int C = layout.chunk_size;
-  const double h = layout.lattice.cell_size;
   ScopedTimer tw(nullptr, "");
-  Result<World> window = [&]() -> Result<World> {
+  const WindowFn window_of = [&](int margin) -> Result<World> {
     std::lock_guard lock(paged_mutex);
-    return paged.window(glm::ivec3(u.column.x - 1, u.column.y - 1, z0), glm::ivec3(u.column.x + 2, u.column.y + 2, z1));
-  }();
+    return paged.window(glm::ivec3(u.column.x - margin, u.column.y - margin, z0),
+                        glm::ivec3(u.column.x + margin + 1, u.column.y + margin + 1, z1));
+  };
+  Result<World> window = window_of(1);
   if (!window.ok()) {
     r.status = window.status();
     return r;
@@ -312,86 +413,16 @@ UnitResult bake_unit(const Unit& u, PagedWorld& paged, std::mutex& paged_mutex, 
   r.seconds[0] = tw.seconds();
   for (int z = z0; z < z1; ++z)
     if (w.chunk_kind(glm::ivec3(u.column, z)) == ChunkKind::kMixed) ++r.mixed_chunks;
-  if (p.mesh) {
+  // Each product in turn, timed; the first error stops the unit.
+  auto run = [&](bool wanted, int slot, auto&& bake) {
+    if (!wanted || !r.status.ok()) return;
     ScopedTimer t(nullptr, "");
-    for (int z = z0; z < z1 && r.status.ok(); ++z) {
-      const glm::ivec3 c(u.column, z);
-      Result<ChunkMesh> m = contour_chunk(w, c);
-      if (!m.ok()) {
-        r.status = m.status();
-        break;
-      }
-      if (m.value().mesh.triangles.empty()) continue;
-      const std::string name = "mesh/" + chunk_name(c) + ".glb";
-      // save_mesh writes atomically; its bytes are read back for the checksum.
-      Status s = save_mesh(m.value().mesh, (dir / name).string());
-      if (s.ok()) {
-        Result<std::string> bytes = read_file((dir / name).string());
-        if (!bytes.ok()) s = bytes.status();
-        else {
-          r.files.push_back({name, bytes.value().size(), crc_of(bytes.value())});
-          r.bytes[0] += bytes.value().size();
-        }
-      }
-      r.status = s;
-    }
-    r.seconds[1] = t.seconds();
-  }
-  if (p.nav && r.status.ok()) {
-    ScopedTimer t(nullptr, "");
-    NavConfig config;
-    Result<NavMesh> nav = NavMesh::build(w, config);
-    if (!nav.ok()) {
-      r.status = nav.status();
-      return r;
-    }
-    NavQuery query(nav.value());
-    for (int z = z0; z < z1 && r.status.ok(); ++z) {
-      const glm::ivec3 c(u.column, z);
-      if (w.chunk_kind(c) != ChunkKind::kMixed) continue;
-      std::vector<float> heights(size_t(C) * C, std::nanf(""));
-      bool any = false;
-      const double zmid = layout.lattice.node_position(glm::ivec3(0, 0, z * C)).z + 0.5 * C * h;
-      for (int v = 0; v < C; ++v)
-        for (int uu = 0; uu < C; ++uu) {
-          const glm::ivec3 node(c.x * C + uu, c.y * C + v, z * C);
-          glm::dvec3 pos = layout.lattice.node_position(node);
-          pos.z = zmid;
-          Result<NavPoint> np = query.nearest_walkable(pos, glm::dvec3(0.49 * h, 0.49 * h, 0.5 * C * h));
-          if (np.ok()) {
-            heights[size_t(v) * C + uu] = float(np.value().position.z);
-            any = true;
-          }
-        }
-      if (!any) continue;
-      std::string bytes(heights.size() * sizeof(float), '\0');
-      std::memcpy(bytes.data(), heights.data(), bytes.size());
-      r.status = write_product(dir, "nav/" + chunk_name(c) + ".nav", bytes, r, 1);
-    }
-    r.seconds[2] = t.seconds();
-  }
-  if (p.voxels && r.status.ok()) {
-    ScopedTimer t(nullptr, "");
-    VoxelConfig config;
-    config.voxel_size = 2.0 * h;
-    const int m = 2, n = C / m;
-    for (int z = z0; z < z1 && r.status.ok(); ++z) {
-      const glm::ivec3 c(u.column, z);
-      if (w.chunk_kind(c) != ChunkKind::kMixed) continue;
-      VoxelizeOptions options;
-      options.box = VoxelBox{c * n, glm::ivec3(n)};
-      Result<VoxelGrid> grid = voxelize(w, config, options);
-      if (!grid.ok()) {
-        r.status = grid.status();
-        break;
-      }
-      std::string bytes(grid.value().occupancy.size(), '\0');
-      for (size_t i = 0; i < bytes.size(); ++i)
-        bytes[i] = char(uint8_t(std::lround(std::clamp(grid.value().occupancy[i], 0.0f, 1.0f) * 255.0f)));
-      r.status = write_product(dir, "voxels/" + chunk_name(c) + ".occ", bytes, r, 2);
-    }
-    r.seconds[3] = t.seconds();
-  }
+    r.status = bake();
+    r.seconds[slot] = t.seconds();
+  };
+  run(p.mesh, 1, [&] { return bake_meshes(w, window_of, u, z0, z1, lods, dir, r); });
+  run(p.nav, 2, [&] { return bake_nav(w, u, z0, z1, layout, dir, r); });
+  run(p.voxels, 3, [&] { return bake_voxels(w, u, z0, z1, layout, dir, r); });
   return r;
 }
 
@@ -431,7 +462,8 @@ Status check_files(const fs::path& shard_dir, const nlohmann::json& manifest, si
 }
 
 // Refuses an output folder holding another world's bake (any shard manifest or index).
-Status check_same_world(const fs::path& out, const std::string& world_id, const std::string& products, int shards) {
+Status check_same_world(const fs::path& out, const std::string& world_id, const std::string& products, int shards,
+                        int lods) {
   std::error_code ec;
   std::vector<fs::path> manifests;
   if (fs::exists(out / "index.json", ec)) manifests.push_back(out / "index.json");
@@ -456,6 +488,10 @@ Status check_same_world(const fs::path& out, const std::string& world_id, const 
     if (other_products != products)
       return Status(ErrorCode::kInvalidArgument, out.string() + " holds a bake of other products (" + m.string() +
                                                      ": " + other_products + "; this bake: " + products + ")");
+    if (lods > 0 && j.value().value("lods", 1) != lods)
+      return Status(ErrorCode::kInvalidArgument, out.string() + " holds a bake of " +
+                                                     std::to_string(j.value().value("lods", 1)) + " mesh levels, not " +
+                                                     std::to_string(lods) + " (" + m.string() + "); use another --out");
   }
   return Status();
 }
@@ -492,7 +528,6 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
   Result<std::pair<int, int>> shard = parse_shard(a.shard);
   if (!shard.ok()) return fail(cmd, shard.status());
   const int si = shard.value().first, sn = shard.value().second;
-  if (a.lods != 1) return fail(cmd, "--lods " + std::to_string(a.lods) + ": only 1 is supported (the library has no LOD meshes yet)");
   Result<Products> products = parse_products(a.products);
   if (!products.ok()) return fail(cmd, products.status());
   const std::string product_list = join(products.value().names());
@@ -500,7 +535,13 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
   Result<BakeWorld> world = open_bake_world(a);
   if (!world.ok()) return fail(cmd, world.status());
   const fs::path out(a.out);
-  if (Status s = check_same_world(out, world.value().id, product_list, sn); !s.ok()) return fail(cmd, s);
+  const int chunk_size = world.value().source->layout().chunk_size;
+  if (a.lods < 1 || a.lods > max_lod_level(chunk_size) + 1) {
+    return fail(cmd, "--lods " + std::to_string(a.lods) + ": 1 .. " + std::to_string(max_lod_level(chunk_size) + 1) +
+                         " for chunks of " + std::to_string(chunk_size) +
+                         " cells (level k keeps every 2^k-th ray; coarse chunks keep at least 8 cells)");
+  }
+  if (Status s = check_same_world(out, world.value().id, product_list, sn, a.lods); !s.ok()) return fail(cmd, s);
   const fs::path dir = out / "shards" / std::to_string(si);
   const fs::path manifest_path = dir / "manifest.json";
   std::error_code ec;
@@ -538,7 +579,9 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
     before += u.cost;
   }
   const double plan_seconds = tplan.seconds();
-  for (const char* sub : {"mesh", "nav", "voxels"}) {
+  std::vector<std::string> folders = {"mesh", "nav", "voxels"};
+  for (int level = 1; level < a.lods; ++level) folders.push_back("mesh/lod" + std::to_string(level));
+  for (const std::string& sub : folders) {
     fs::create_directories(dir / sub, ec);
     if (ec) return fail(cmd, (dir / sub).string() + ": cannot create the folder (" + ec.message() + ")");
   }
@@ -550,7 +593,7 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
   std::mutex progress_mutex;
   ScopedTimer tbake(nullptr, "");
   tbb::parallel_for(size_t(0), mine.size(), [&](size_t k) {
-    results[k] = bake_unit(mine[k], paged, paged_mutex, products.value(), dir);
+    results[k] = bake_unit(mine[k], paged, paged_mutex, products.value(), a.lods, dir);
     const size_t d = ++done;
     std::lock_guard lock(progress_mutex);
     bar.context()->report_progress("bake", double(d) / double(mine.size()));
@@ -635,7 +678,7 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
   // N from the first manifest found; every other must agree.
   std::string world_id;
   std::vector<std::string> products;
-  int n = -1;
+  int n = -1, lods = 1;
   std::vector<nlohmann::json> manifests;
   for (const auto& [index, path] : found) {
     if (!fs::exists(path / "manifest.json", ec))
@@ -655,6 +698,7 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
       n = shards;
       world_id = j.value("world", std::string());
       products = j.value("products", std::vector<std::string>());
+      lods = j.value("lods", 1);
     }
     if (shards != n)
       return fail(cmd, (path / "manifest.json").string() + ": a bake in " + std::to_string(shards) + " shards, the others in " + std::to_string(n));
@@ -666,6 +710,9 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
                            "', not '" + world_id + "')");
     if (j.value("products", std::vector<std::string>()) != products)
       return fail(cmd, (path / "manifest.json").string() + ": shard of other products");
+    if (j.value("lods", 1) != lods)
+      return fail(cmd, (path / "manifest.json").string() + ": a bake of " + std::to_string(j.value("lods", 1)) +
+                           " mesh levels, the others of " + std::to_string(lods));
     if (Status s = check_files(path, j, nullptr); !s.ok()) return fail(cmd, s);
     manifests.push_back(j);
   }
@@ -673,7 +720,7 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
     if (!found.count(i))
       return fail(cmd, "shard " + std::to_string(i) + "/" + std::to_string(n) + " is missing (" +
                            (out / "shards" / std::to_string(i)).string() + "); re-run it before merging");
-  if (Status s = check_same_world(out, world_id, join(products), n); !s.ok()) return fail(cmd, s);
+  if (Status s = check_same_world(out, world_id, join(products), n, lods); !s.ok()) return fail(cmd, s);
   // Units in column order across shards (each shard's are contiguous and in order).
   nlohmann::json units = nlohmann::json::array();
   size_t files = 0;
@@ -733,7 +780,10 @@ void add_bake_command(CLI::App& app, CommonOptions& common) {
   bake->add_option("--out", a->out, "Output folder (shards go to DIR/shards/i/)");
   bake->add_option("--shard", a->shard, "This process's shard i/N (0/1: the whole world)");
   bake->add_option("--products", a->products, "Products, comma-separated: mesh, nav, voxels")->capture_default_str();
-  bake->add_option("--lods", a->lods, "LOD meshes per chunk (only 1: the library has no LOD meshes yet)")->capture_default_str();
+  bake->add_option("--lods", a->lods,
+                   "Mesh levels per chunk: 1 = full detail only; N adds levels 1 .. N-1 (every 2^k-th ray) under "
+                   "mesh/lod<k>/ (at most 2, 3, 4 for chunks of 16, 32, 64 cells)")
+      ->capture_default_str();
   bake->add_option("--merge", a->merge, "Check every shard's manifest in DIR and write DIR/index.json");
   bake->add_option("--terrain-size", a->terrain_size, "Procedural world instead of WORLD: the landscape of X,Y metres");
   bake->add_option("--cell-size", a->cell_size, "With --terrain-size: cell size h [m]")->capture_default_str();

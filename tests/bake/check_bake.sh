@@ -5,6 +5,8 @@
 #   rerun     a finished shard is skipped on a re-run; a killed (partial) one is redone
 #   faults    merge refuses: a corrupted file (naming it), a missing shard,
 #             shards of another world; no index is written
+#   lods      --lods 2 adds mesh/lod1/ (every 2nd ray): the 2-shard bake equals
+#             the one-process one, and level 1 takes under half the bytes
 # Exits non-zero, naming what failed.
 set -u
 LDC=$1; WORK=$2; CASE=$3
@@ -41,6 +43,21 @@ identity)
   printf '\x01' | dd of="$WORK/three/mesh/$f" bs=1 seek=100 conv=notrunc 2>/dev/null
   (same_bake "$WORK/one" "$WORK/three" 2>/dev/null) && die "same_bake did not notice a changed byte"
   echo "identity ok"
+  ;;
+lods)
+  bake --out "$WORK/one" --shard 0/1 --lods 2 >/dev/null || die "bake 0/1 --lods 2"
+  "$LDC" -q bake --merge "$WORK/one" >/dev/null || die "merge of 0/1"
+  for i in 0 1; do bake --out "$WORK/two" --shard $i/2 --lods 2 >/dev/null || die "bake $i/2 --lods 2"; done
+  "$LDC" -q bake --merge "$WORK/two" >/dev/null || die "merge of 2 shards"
+  same_bake "$WORK/one" "$WORK/two"
+  n1=$(ls "$WORK/one/mesh/lod1" | wc -l)
+  [ "$n1" -gt 0 ] || die "no level-1 meshes"
+  s0=$(cat "$WORK"/one/mesh/*.glb | wc -c); s1=$(cat "$WORK"/one/mesh/lod1/*.glb | wc -c)
+  [ $((2 * s1)) -lt "$s0" ] || die "level-1 meshes take $s1 bytes, level 0 $s0"
+  # a bake of other levels in the same folder is refused
+  err=$(bake --out "$WORK/one" --shard 0/1 2>&1 >/dev/null) && die "a 1-level bake over a 2-level one was accepted"
+  [[ $err == *"holds a bake of 2 mesh levels, not 1"* ]] || die "unexpected refusal: $err"
+  echo "lods ok: $n1 level-1 meshes, $s1 of $s0 bytes"
   ;;
 rerun)
   bake --out "$WORK/b" --shard 1/2 >/dev/null || die "bake 1/2"
