@@ -111,6 +111,25 @@ TEST(JsonInputs, OverlayTruncatedIsRefusedAsMalformed) {
 // Found while writing the fuzzer: the message for a bad entry dump()ed it, recursing once per
 // level. 10,000 nested brackets (fuzz/corpus/json_inputs/overlay_deep_nesting_stack_overflow)
 // overflowed the fuzzer's stack; 300,000 (600 KB) made `ldc render --overlay` die of SIGSEGV.
+// Issue 24 sweep: nlohmann's parser stopped at a zero byte, so a document
+// followed by "\0" and anything was read as the document.
+TEST(JsonInputs, ZeroByteAfterTheDocumentIsRefused) {
+  const std::string overlay = std::string(R"({"path": [[0, 0, 0]]})") + std::string(2, '\0') + "garbage";
+  EXPECT_NE(refusal(read_overlay_text(overlay, "o.json")).find("o.json: not a JSON text file (a zero byte at offset 21)"),
+            std::string::npos);
+  const std::string rays = std::string(R"([{"origin": [0, 0, 0], "direction": [0, 0, 1]}])") + '\0';
+  EXPECT_NE(refusal(read_rays_text(rays, "r.json")).find("r.json: not a JSON text file (a zero byte at offset"),
+            std::string::npos);
+}
+
+// Other fields are allowed: the overlay is often `ldc path`'s whole report.
+TEST(JsonInputs, OverlayTakesAPathReportWithItsOtherFields) {
+  auto r = read_overlay_text(R"({"status": "complete", "path": [[0, 0, 0], [1, 0, 0]], "length": 1.0})", "o.json");
+  ASSERT_TRUE(r.ok()) << r.status().message();
+  ASSERT_EQ(r.value().paths.size(), 1u);
+  EXPECT_EQ(r.value().paths[0].size(), 2u);
+}
+
 TEST(JsonInputs, OverlayDeeplyNestedEntryIsRefusedWithoutOverflowingTheStack) {
   auto r = read_overlay_text("{\"points\": [" + nested(300000) + "]}", "o.json");
   EXPECT_NE(refusal(r).find("o.json: arrays and objects nested deeper than 64 levels"), std::string::npos);

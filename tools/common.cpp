@@ -1,5 +1,6 @@
 #include "common.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -325,9 +326,16 @@ bool has_ldc_extension(const std::string& path) {
 }
 
 bool is_store_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  // Regular files only, opened without blocking: a FIFO with no writer hung
+  // `info` and `render` here (load_world then refuses it, naming it).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) return false;
+  struct stat st;
   char magic[4] = {};
-  return in.read(magic, 4) && std::string_view(magic, 4) == "LDCS";
+  const bool is_store = ::fstat(fd, &st) == 0 && S_ISREG(st.st_mode) && ::read(fd, magic, 4) == 4 &&
+                        std::string_view(magic, 4) == "LDCS";
+  ::close(fd);
+  return is_store;
 }
 
 Result<World> load_world_file(const std::string& path, const LoadLimits& limits, Context* ctx) {

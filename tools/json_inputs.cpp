@@ -44,6 +44,12 @@ Result<Json> parse_text(std::string_view text, const std::string& name) {
     return Status(ErrorCode::kParseError, name + ": arrays and objects nested deeper than " +
                                               std::to_string(kMaxJsonDepth) + " levels (these files need 4)");
   }
+  // nlohmann's parser stops at a zero byte, so a valid document followed by
+  // "\0" and anything at all was read as the document (issue 24 sweep).
+  if (const size_t nul = text.find('\0'); nul != std::string_view::npos) {
+    return Status(ErrorCode::kParseError, name + ": not a JSON text file (a zero byte at offset " +
+                                              std::to_string(nul) + ")");
+  }
   try {
     return Json::parse(text);
   } catch (const nlohmann::json::exception& e) {  // syntax errors, and numbers too large for a double
