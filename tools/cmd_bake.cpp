@@ -1,7 +1,7 @@
 // ldc bake (issue 23): the offline bake of a large world, sharded for a batch
 // scheduler (a Slurm job array, a Kubernetes Indexed Job), and its merge.
 //
-//   ldc bake WORLD --out DIR --shard i/N [--products mesh,nav,voxels] [--lods N]
+//   ldc bake WORLD --out DIR --shard i/N [--products mesh,nav,voxels] [--lods N] [--mesh-format glb|drc]
 //   ldc bake --merge DIR
 //
 // Work units are chunk columns (x, y) holding at least one chunk that may be
@@ -54,6 +54,7 @@ struct BakeArgs {
   std::string out;
   std::string shard;
   std::string products = "mesh,nav,voxels";
+  std::string mesh_format = "glb";  // or drc (Draco)
   int lods = 1;
   std::string merge;
   std::string terrain_size;  // procedural world without a file
@@ -299,14 +300,14 @@ Status write_product(const fs::path& dir, const std::string& name, const std::st
 // The unit's column and `margin` chunk columns around it, the whole z range.
 using WindowFn = std::function<Result<World>(int margin)>;
 
-// Each chunk of the unit's column as a mesh, at level 0 ("mesh/<chunk>.glb")
-// and at levels 1 .. lods - 1 ("mesh/lod<k>/<chunk>.glb", from the window
+// Each chunk of the unit's column as a mesh (.glb or .drc), at level 0
+// ("mesh/<chunk>.glb") and at levels 1 .. lods - 1 ("mesh/lod<k>/<chunk>.glb", from the window
 // coarsened to every 2^k-th ray: ldc/lod.h). A chunk's mesh reads about ten
 // cells around it, so coarse chunks of 8 cells take a window of two chunk
 // columns around the unit (contour_chunk refuses a reach into a cut face).
 // Empty meshes write no file.
 Status bake_meshes(const World& w, const WindowFn& window, const Unit& u, int z0, int z1, int lods,
-                   const fs::path& dir, UnitResult& r) {
+                   const std::string& format, const fs::path& dir, UnitResult& r) {
   for (int level = 0; level < lods; ++level) {
     std::optional<World> coarse;
     if (level > 0) {
@@ -327,7 +328,7 @@ Status bake_meshes(const World& w, const WindowFn& window, const Unit& u, int z0
       Result<ChunkMesh> m = contour_chunk(at_level, c);
       if (!m.ok()) return m.status();
       if (m.value().mesh.triangles.empty()) continue;
-      const std::string name = folder + chunk_name(c) + ".glb";
+      const std::string name = folder + chunk_name(c) + "." + format;
       // save_mesh writes atomically; its bytes are read back for the checksum.
       if (Status s = save_mesh(m.value().mesh, (dir / name).string()); !s.ok()) return s;
       Result<std::string> bytes = read_file((dir / name).string());
@@ -394,7 +395,7 @@ Status bake_voxels(const World& w, const Unit& u, int z0, int z1, const SourceLa
 }
 
 UnitResult bake_unit(const Unit& u, PagedWorld& paged, std::mutex& paged_mutex, const Products& p, int lods,
-                     const fs::path& dir) {
+                     const std::string& mesh_format, const fs::path& dir) {
   UnitResult r;
   const SourceLayout layout = paged.layout();
   const int z0 = layout.box.chunk_origin.z, z1 = z0 + layout.box.chunk_dims.z;
@@ -420,7 +421,7 @@ UnitResult bake_unit(const Unit& u, PagedWorld& paged, std::mutex& paged_mutex, 
     r.status = bake();
     r.seconds[slot] = t.seconds();
   };
-  run(p.mesh, 1, [&] { return bake_meshes(w, window_of, u, z0, z1, lods, dir, r); });
+  run(p.mesh, 1, [&] { return bake_meshes(w, window_of, u, z0, z1, lods, mesh_format, dir, r); });
   run(p.nav, 2, [&] { return bake_nav(w, u, z0, z1, layout, dir, r); });
   run(p.voxels, 3, [&] { return bake_voxels(w, u, z0, z1, layout, dir, r); });
   return r;
@@ -462,8 +463,9 @@ Status check_files(const fs::path& shard_dir, const nlohmann::json& manifest, si
 }
 
 // Refuses an output folder holding another world's bake (any shard manifest or index).
+// lods and mesh_format: 0 / empty skip their checks.
 Status check_same_world(const fs::path& out, const std::string& world_id, const std::string& products, int shards,
-                        int lods) {
+                        int lods, const std::string& mesh_format) {
   std::error_code ec;
   std::vector<fs::path> manifests;
   if (fs::exists(out / "index.json", ec)) manifests.push_back(out / "index.json");
@@ -492,6 +494,11 @@ Status check_same_world(const fs::path& out, const std::string& world_id, const 
       return Status(ErrorCode::kInvalidArgument, out.string() + " holds a bake of " +
                                                      std::to_string(j.value().value("lods", 1)) + " mesh levels, not " +
                                                      std::to_string(lods) + " (" + m.string() + "); use another --out");
+    if (!mesh_format.empty() && j.value().value("mesh_format", std::string("glb")) != mesh_format)
+      return Status(ErrorCode::kInvalidArgument, out.string() + " holds a bake of ." +
+                                                     j.value().value("mesh_format", std::string("glb")) +
+                                                     " meshes, not ." + mesh_format + " (" + m.string() +
+                                                     "); use another --out");
   }
   return Status();
 }
@@ -541,7 +548,7 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
                          " for chunks of " + std::to_string(chunk_size) +
                          " cells (level k keeps every 2^k-th ray; coarse chunks keep at least 8 cells)");
   }
-  if (Status s = check_same_world(out, world.value().id, product_list, sn, a.lods); !s.ok()) return fail(cmd, s);
+  if (Status s = check_same_world(out, world.value().id, product_list, sn, a.lods, a.mesh_format); !s.ok()) return fail(cmd, s);
   const fs::path dir = out / "shards" / std::to_string(si);
   const fs::path manifest_path = dir / "manifest.json";
   std::error_code ec;
@@ -593,7 +600,7 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
   std::mutex progress_mutex;
   ScopedTimer tbake(nullptr, "");
   tbb::parallel_for(size_t(0), mine.size(), [&](size_t k) {
-    results[k] = bake_unit(mine[k], paged, paged_mutex, products.value(), a.lods, dir);
+    results[k] = bake_unit(mine[k], paged, paged_mutex, products.value(), a.lods, a.mesh_format, dir);
     const size_t d = ++done;
     std::lock_guard lock(progress_mutex);
     bar.context()->report_progress("bake", double(d) / double(mine.size()));
@@ -623,6 +630,7 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
                              {"shards", sn},
                              {"products", products.value().names()},
                              {"lods", a.lods},
+                             {"mesh_format", a.mesh_format},
                              {"chunk_size", layout.chunk_size},
                              {"cell_size", layout.lattice.cell_size},
                              {"units_total", all.size()},
@@ -679,6 +687,7 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
   std::string world_id;
   std::vector<std::string> products;
   int n = -1, lods = 1;
+  std::string mesh_format;
   std::vector<nlohmann::json> manifests;
   for (const auto& [index, path] : found) {
     if (!fs::exists(path / "manifest.json", ec))
@@ -699,6 +708,7 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
       world_id = j.value("world", std::string());
       products = j.value("products", std::vector<std::string>());
       lods = j.value("lods", 1);
+      mesh_format = j.value("mesh_format", std::string("glb"));
     }
     if (shards != n)
       return fail(cmd, (path / "manifest.json").string() + ": a bake in " + std::to_string(shards) + " shards, the others in " + std::to_string(n));
@@ -713,6 +723,9 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
     if (j.value("lods", 1) != lods)
       return fail(cmd, (path / "manifest.json").string() + ": a bake of " + std::to_string(j.value("lods", 1)) +
                            " mesh levels, the others of " + std::to_string(lods));
+    if (j.value("mesh_format", std::string("glb")) != mesh_format)
+      return fail(cmd, (path / "manifest.json").string() + ": a bake of ." + j.value("mesh_format", std::string("glb")) +
+                           " meshes, the others of ." + mesh_format);
     if (Status s = check_files(path, j, nullptr); !s.ok()) return fail(cmd, s);
     manifests.push_back(j);
   }
@@ -720,7 +733,7 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
     if (!found.count(i))
       return fail(cmd, "shard " + std::to_string(i) + "/" + std::to_string(n) + " is missing (" +
                            (out / "shards" / std::to_string(i)).string() + "); re-run it before merging");
-  if (Status s = check_same_world(out, world_id, join(products), n, lods); !s.ok()) return fail(cmd, s);
+  if (Status s = check_same_world(out, world_id, join(products), n, lods, mesh_format); !s.ok()) return fail(cmd, s);
   // Units in column order across shards (each shard's are contiguous and in order).
   nlohmann::json units = nlohmann::json::array();
   size_t files = 0;
@@ -756,6 +769,7 @@ int run_merge(const BakeArgs& a, const CommonOptions& common) {
                           {"world", world_id},
                           {"products", products},
                           {"lods", first.value("lods", 1)},
+                          {"mesh_format", first.value("mesh_format", std::string("glb"))},
                           {"chunk_size", first.value("chunk_size", 0)},
                           {"cell_size", first.value("cell_size", 0.0)},
                           {"units", units}};
@@ -780,6 +794,9 @@ void add_bake_command(CLI::App& app, CommonOptions& common) {
   bake->add_option("--out", a->out, "Output folder (shards go to DIR/shards/i/)");
   bake->add_option("--shard", a->shard, "This process's shard i/N (0/1: the whole world)");
   bake->add_option("--products", a->products, "Products, comma-separated: mesh, nav, voxels")->capture_default_str();
+  bake->add_option("--mesh-format", a->mesh_format, "Chunk meshes as glb (binary glTF) or drc (Draco)")
+      ->check(CLI::IsMember({"glb", "drc"}))
+      ->capture_default_str();
   bake->add_option("--lods", a->lods,
                    "Mesh levels per chunk: 1 = full detail only; N adds levels 1 .. N-1 (every 2^k-th ray) under "
                    "mesh/lod<k>/ (at most 2, 3, 4 for chunks of 16, 32, 64 cells)")

@@ -6,7 +6,8 @@
 #   faults    merge refuses: a corrupted file (naming it), a missing shard,
 #             shards of another world; no index is written
 #   lods      --lods 2 adds mesh/lod1/ (every 2nd ray): the 2-shard bake equals
-#             the one-process one, and level 1 takes under half the bytes
+#             the one-process one, and level 1 takes under half the bytes;
+#             --mesh-format drc writes Draco files
 # Exits non-zero, naming what failed.
 set -u
 LDC=$1; WORK=$2; CASE=$3
@@ -57,7 +58,13 @@ lods)
   # a bake of other levels in the same folder is refused
   err=$(bake --out "$WORK/one" --shard 0/1 2>&1 >/dev/null) && die "a 1-level bake over a 2-level one was accepted"
   [[ $err == *"holds a bake of 2 mesh levels, not 1"* ]] || die "unexpected refusal: $err"
-  echo "lods ok: $n1 level-1 meshes, $s1 of $s0 bytes"
+  # --mesh-format drc: Draco files at both levels; a .glb bake over them is refused
+  bake --out "$WORK/drc" --shard 0/1 --lods 2 --mesh-format drc >/dev/null || die "bake --mesh-format drc"
+  nd=$(ls "$WORK"/drc/shards/0/mesh/*.drc "$WORK"/drc/shards/0/mesh/lod1/*.drc | wc -l)
+  [ "$nd" -gt 0 ] && [ -z "$(ls "$WORK"/drc/shards/0/mesh/*.glb 2>/dev/null)" ] || die "no .drc meshes (or .glb ones)"
+  err=$(bake --out "$WORK/drc" --shard 0/1 --lods 2 2>&1 >/dev/null) && die "a .glb bake over a .drc one was accepted"
+  [[ $err == *"holds a bake of .drc meshes, not .glb"* ]] || die "unexpected refusal: $err"
+  echo "lods ok: $n1 level-1 meshes, $s1 of $s0 bytes; $nd .drc meshes"
   ;;
 rerun)
   bake --out "$WORK/b" --shard 1/2 >/dev/null || die "bake 1/2"
