@@ -51,7 +51,7 @@ fi
 
 # npm tools the tests check outputs with (versions pinned in tests/js/package-lock.json).
 js_dir="$(cd "$(dirname "$0")/.." && pwd)/tests/js"
-if [ ! -d "$js_dir/node_modules/gltf-validator" ]; then
-  echo "install-deps: npm ci in tests/js (gltf-validator)"
+if [ ! -d "$js_dir/node_modules/gltf-validator" ] || [ ! -d "$js_dir/node_modules/kubernetes-models" ]; then
+  echo "install-deps: npm ci in tests/js (gltf-validator, kubernetes-models, js-yaml)"
   (cd "$js_dir" && npm ci --no-audit --no-fund --silent)
 fi
