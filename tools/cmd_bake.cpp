@@ -527,6 +527,169 @@ Result<std::pair<int, int>> parse_shard(const std::string& text) {
   return std::make_pair(int(i), int(n));
 }
 
+// The shard's finished manifest, when it checks out: prints "skipped" and
+// returns true. A manifest that does not check out is removed (with a
+// warning) for the shard to be baked again; *refusal is set when the folder
+// holds a bake in another shard count.
+bool finished_shard(const fs::path& out, const fs::path& dir, int si, int sn, const CommonOptions& common,
+                    std::optional<int>* refusal) {
+  const std::string cmd = "bake";
+  const fs::path manifest_path = dir / "manifest.json";
+  std::error_code ec;
+  if (!fs::exists(manifest_path, ec)) return false;
+  Result<nlohmann::json> m = read_json(manifest_path);
+  size_t checked = 0;
+  Status s = m.ok() ? check_files(dir, m.value(), &checked) : m.status();
+  if (s.ok() && (m.value().value("shards", -1) != sn || m.value().value("shard", -1) != si))
+    s = Status(ErrorCode::kCorruptData, manifest_path.string() + " is of shard " +
+                                            std::to_string(m.value().value("shard", -1)) + "/" +
+                                            std::to_string(m.value().value("shards", -1)));
+  if (s.ok()) {
+    if (common.json)
+      std::printf("%s\n", json_text(with_warnings({{"shard", si}, {"shards", sn}, {"skipped", true}, {"files_checked", checked}})).c_str());
+    else
+      std::printf("shard %d/%d already baked (%zu files checked against %s); skipped\n", si, sn, checked,
+                  manifest_path.string().c_str());
+    return true;
+  }
+  if (m.ok() && m.value().value("shards", sn) != sn) {
+    *refusal = fail(cmd, out.string() + " holds a bake in " + std::to_string(m.value().value("shards", 0)) +
+                             " shards, not " + std::to_string(sn) + " (" + manifest_path.string() + "); use another --out");
+    return false;
+  }
+  warn(cmd, "re-baking shard " + std::to_string(si) + ": " + s.message());
+  fs::remove(manifest_path, ec);
+  return false;
+}
+
+// Every unit of the world, and this shard's (contiguous ranges of equal cost).
+struct ShardPlan {
+  std::vector<Unit> all, mine;
+  int64_t total_cost = 0, mine_cost = 0;
+};
+
+ShardPlan plan_shard(const BakeWorld& world, int si, int sn) {
+  ShardPlan plan;
+  plan.all = plan_units(world);
+  for (const Unit& u : plan.all) plan.total_cost += u.cost;
+  int64_t before = 0;
+  for (const Unit& u : plan.all) {
+    if (shard_of(before, u.cost, plan.total_cost, sn) == si) {
+      plan.mine.push_back(u);
+      plan.mine_cost += u.cost;
+    }
+    before += u.cost;
+  }
+  return plan;
+}
+
+// The shard's units baked in parallel (one window each), with a progress bar.
+std::vector<UnitResult> bake_units(const BakeArgs& a, const BakeWorld& world, const ShardPlan& plan,
+                                   const Products& products, const fs::path& dir, const CommonOptions& common) {
+  ProgressBar bar(!common.quiet);
+  PagedWorld paged(world.source);
+  std::mutex paged_mutex, progress_mutex;
+  std::vector<UnitResult> results(plan.mine.size());
+  std::atomic<size_t> done{0};
+  tbb::parallel_for(size_t(0), plan.mine.size(), [&](size_t k) {
+    results[k] = bake_unit(plan.mine[k], paged, paged_mutex, products, a.lods, a.mesh_format, dir);
+    const size_t d = ++done;
+    std::lock_guard lock(progress_mutex);
+    bar.context()->report_progress("bake", double(d) / double(plan.mine.size()));
+  }, tbb::simple_partitioner());
+  bar.finish();
+  return results;
+}
+
+// What the shard's units wrote, summed; the units with their files for the manifest.
+struct ShardTotals {
+  nlohmann::json units = nlohmann::json::array();
+  size_t files = 0, mixed = 0;
+  uint64_t bytes[3] = {0, 0, 0};     // mesh, nav, voxels
+  double seconds[4] = {0, 0, 0, 0};  // window, mesh, nav, voxels (CPU, summed over units)
+};
+
+Result<ShardTotals> shard_totals(const ShardPlan& plan, const std::vector<UnitResult>& results) {
+  ShardTotals t;
+  for (size_t k = 0; k < plan.mine.size(); ++k) {
+    const UnitResult& r = results[k];
+    const Unit& u = plan.mine[k];
+    if (!r.status.ok())
+      return Status(r.status.code(), "column " + std::to_string(u.column.x) + "," + std::to_string(u.column.y) + ": " +
+                                         r.status.message());
+    nlohmann::json fl = nlohmann::json::array();
+    for (const FileEntry& f : r.files) fl.push_back({{"name", f.name}, {"bytes", f.bytes}, {"crc32", hex32(f.crc)}});
+    t.units.push_back({{"column", {u.column.x, u.column.y}}, {"cost", u.cost}, {"files", fl}});
+    t.files += r.files.size();
+    t.mixed += r.mixed_chunks;
+    for (int i = 0; i < 3; ++i) t.bytes[i] += r.bytes[i];
+    for (int i = 0; i < 4; ++i) t.seconds[i] += r.seconds[i];
+  }
+  return t;
+}
+
+nlohmann::json shard_manifest(const BakeArgs& a, const BakeWorld& world, const ShardPlan& plan, const ShardTotals& t,
+                              const Products& products, int si, int sn) {
+  const SourceLayout layout = world.source->layout();
+  return {{"format", kShardFormat},
+          {"world", world.id},
+          {"shard", si},
+          {"shards", sn},
+          {"products", products.names()},
+          {"lods", a.lods},
+          {"mesh_format", a.mesh_format},
+          {"chunk_size", layout.chunk_size},
+          {"cell_size", layout.lattice.cell_size},
+          {"units_total", plan.all.size()},
+          {"cost_total", plan.total_cost},
+          {"units", t.units}};
+}
+
+// What the shard did, as text or --json: units, files, bytes per product, times.
+struct ShardTimes {
+  double total = 0, plan = 0, bake_wall = 0;
+};
+
+void print_shard_report(const ShardPlan& plan, const ShardTotals& sum, const SourceLayout& layout, int si, int sn,
+                        const ShardTimes& times, const fs::path& manifest_path, const CommonOptions& common) {
+  const double chunk_m = layout.chunk_size * layout.lattice.cell_size;
+  const double km2 = double(plan.mine.size()) * chunk_m * chunk_m * 1e-6;
+  if (!common.json) {
+    std::printf("baked shard %d/%d: %zu of %zu columns, %zu mixed chunks, %zu files (mesh %" PRIu64 " B, nav %" PRIu64
+                " B, voxels %" PRIu64 " B) in %.2f s\n  manifest: %s\n",
+                si, sn, plan.mine.size(), plan.all.size(), sum.mixed, sum.files, sum.bytes[0], sum.bytes[1],
+                sum.bytes[2], times.total, manifest_path.string().c_str());
+    return;
+  }
+  nlohmann::json report = {{"shard", si},
+                           {"shards", sn},
+                           {"skipped", false},
+                           {"units", plan.mine.size()},
+                           {"units_total", plan.all.size()},
+                           {"cost", plan.mine_cost},
+                           {"mixed_chunks", sum.mixed},
+                           {"files", sum.files},
+                           {"area_km2", km2},
+                           {"bytes", {{"mesh", sum.bytes[0]}, {"nav", sum.bytes[1]}, {"voxels", sum.bytes[2]}}},
+                           {"seconds",
+                            {{"total", times.total},
+                             {"plan", times.plan},
+                             {"bake_wall", times.bake_wall},
+                             {"window_cpu", sum.seconds[0]},
+                             {"mesh_cpu", sum.seconds[1]},
+                             {"nav_cpu", sum.seconds[2]},
+                             {"voxels_cpu", sum.seconds[3]}}}};
+  std::printf("%s\n", json_text(with_warnings(report)).c_str());
+}
+
+Status check_lods(int lods, int chunk_size) {
+  if (lods >= 1 && lods <= max_lod_level(chunk_size) + 1) return Status();
+  return Status(ErrorCode::kInvalidArgument,
+                "--lods " + std::to_string(lods) + ": 1 .. " + std::to_string(max_lod_level(chunk_size) + 1) +
+                    " for chunks of " + std::to_string(chunk_size) +
+                    " cells (level k keeps every 2^k-th ray; coarse chunks keep at least 8 cells)");
+}
+
 int run_bake(const BakeArgs& a, const CommonOptions& common) {
   const std::string cmd = "bake";
   set_thread_count(common.threads);
@@ -537,247 +700,182 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
   const int si = shard.value().first, sn = shard.value().second;
   Result<Products> products = parse_products(a.products);
   if (!products.ok()) return fail(cmd, products.status());
-  const std::string product_list = join(products.value().names());
   ScopedTimer total(nullptr, "");
   Result<BakeWorld> world = open_bake_world(a);
   if (!world.ok()) return fail(cmd, world.status());
   const fs::path out(a.out);
-  const int chunk_size = world.value().source->layout().chunk_size;
-  if (a.lods < 1 || a.lods > max_lod_level(chunk_size) + 1) {
-    return fail(cmd, "--lods " + std::to_string(a.lods) + ": 1 .. " + std::to_string(max_lod_level(chunk_size) + 1) +
-                         " for chunks of " + std::to_string(chunk_size) +
-                         " cells (level k keeps every 2^k-th ray; coarse chunks keep at least 8 cells)");
-  }
-  if (Status s = check_same_world(out, world.value().id, product_list, sn, a.lods, a.mesh_format); !s.ok()) return fail(cmd, s);
+  const SourceLayout layout = world.value().source->layout();
+  if (Status s = check_lods(a.lods, layout.chunk_size); !s.ok()) return fail(cmd, s.message());
+  const std::string product_list = join(products.value().names());
+  if (Status s = check_same_world(out, world.value().id, product_list, sn, a.lods, a.mesh_format); !s.ok())
+    return fail(cmd, s);
   const fs::path dir = out / "shards" / std::to_string(si);
-  const fs::path manifest_path = dir / "manifest.json";
-  std::error_code ec;
-  // A finished shard (its manifest present and every file checking out) is skipped.
-  if (fs::exists(manifest_path, ec)) {
-    Result<nlohmann::json> m = read_json(manifest_path);
-    size_t checked = 0;
-    Status s = m.ok() ? check_files(dir, m.value(), &checked) : m.status();
-    if (s.ok() && (m.value().value("shards", -1) != sn || m.value().value("shard", -1) != si))
-      s = Status(ErrorCode::kCorruptData, manifest_path.string() + " is of shard " +
-                                              std::to_string(m.value().value("shard", -1)) + "/" +
-                                              std::to_string(m.value().value("shards", -1)));
-    if (s.ok()) {
-      if (common.json)
-        std::printf("%s\n", json_text(with_warnings({{"shard", si}, {"shards", sn}, {"skipped", true}, {"files_checked", checked}})).c_str());
-      else
-        std::printf("shard %d/%d already baked (%zu files checked against %s); skipped\n", si, sn, checked,
-                    manifest_path.string().c_str());
-      return kExitSuccess;
-    }
-    if (m.ok() && m.value().value("shards", sn) != sn)
-      return fail(cmd, out.string() + " holds a bake in " + std::to_string(m.value().value("shards", 0)) +
-                           " shards, not " + std::to_string(sn) + " (" + manifest_path.string() + "); use another --out");
-    warn(cmd, "re-baking shard " + std::to_string(si) + ": " + s.message());
-    fs::remove(manifest_path, ec);
-  }
+  std::optional<int> refusal;
+  if (finished_shard(out, dir, si, sn, common, &refusal)) return kExitSuccess;
+  if (refusal) return *refusal;
   ScopedTimer tplan(nullptr, "");
-  const std::vector<Unit> all = plan_units(world.value());
-  int64_t total_cost = 0;
-  for (const Unit& u : all) total_cost += u.cost;
-  std::vector<Unit> mine;
-  int64_t before = 0;
-  for (const Unit& u : all) {
-    if (shard_of(before, u.cost, total_cost, sn) == si) mine.push_back(u);
-    before += u.cost;
-  }
+  const ShardPlan plan = plan_shard(world.value(), si, sn);
   const double plan_seconds = tplan.seconds();
   std::vector<std::string> folders = {"mesh", "nav", "voxels"};
   for (int level = 1; level < a.lods; ++level) folders.push_back("mesh/lod" + std::to_string(level));
   for (const std::string& sub : folders) {
+    std::error_code ec;
     fs::create_directories(dir / sub, ec);
     if (ec) return fail(cmd, (dir / sub).string() + ": cannot create the folder (" + ec.message() + ")");
   }
-  ProgressBar bar(!common.quiet);
-  PagedWorld paged(world.value().source);
-  std::mutex paged_mutex;
-  std::vector<UnitResult> results(mine.size());
-  std::atomic<size_t> done{0};
-  std::mutex progress_mutex;
   ScopedTimer tbake(nullptr, "");
-  tbb::parallel_for(size_t(0), mine.size(), [&](size_t k) {
-    results[k] = bake_unit(mine[k], paged, paged_mutex, products.value(), a.lods, a.mesh_format, dir);
-    const size_t d = ++done;
-    std::lock_guard lock(progress_mutex);
-    bar.context()->report_progress("bake", double(d) / double(mine.size()));
-  }, tbb::simple_partitioner());
-  bar.finish();
+  const std::vector<UnitResult> results = bake_units(a, world.value(), plan, products.value(), dir, common);
   const double bake_seconds = tbake.seconds();
-  nlohmann::json units = nlohmann::json::array();
-  size_t files = 0, mixed = 0;
-  uint64_t bytes[3] = {0, 0, 0};
-  double seconds[4] = {0, 0, 0, 0};
-  for (size_t k = 0; k < mine.size(); ++k) {
-    const UnitResult& r = results[k];
-    if (!r.status.ok())
-      return fail(cmd, "column " + std::to_string(mine[k].column.x) + "," + std::to_string(mine[k].column.y) + ": " + r.status.message());
-    nlohmann::json fl = nlohmann::json::array();
-    for (const FileEntry& f : r.files) fl.push_back({{"name", f.name}, {"bytes", f.bytes}, {"crc32", hex32(f.crc)}});
-    units.push_back({{"column", {mine[k].column.x, mine[k].column.y}}, {"cost", mine[k].cost}, {"files", fl}});
-    files += r.files.size();
-    mixed += r.mixed_chunks;
-    for (int i = 0; i < 3; ++i) bytes[i] += r.bytes[i];
-    for (int i = 0; i < 4; ++i) seconds[i] += r.seconds[i];
-  }
-  const SourceLayout layout = world.value().source->layout();
-  nlohmann::json manifest = {{"format", kShardFormat},
-                             {"world", world.value().id},
-                             {"shard", si},
-                             {"shards", sn},
-                             {"products", products.value().names()},
-                             {"lods", a.lods},
-                             {"mesh_format", a.mesh_format},
-                             {"chunk_size", layout.chunk_size},
-                             {"cell_size", layout.lattice.cell_size},
-                             {"units_total", all.size()},
-                             {"cost_total", total_cost},
-                             {"units", units}};
+  Result<ShardTotals> t = shard_totals(plan, results);
+  if (!t.ok()) return fail(cmd, t.status().message());
+  const fs::path manifest_path = dir / "manifest.json";
+  const nlohmann::json manifest = shard_manifest(a, world.value(), plan, t.value(), products.value(), si, sn);
   if (Status s = write_file_atomically(manifest_path.string(), json_text(manifest, 1) + "\n"); !s.ok()) return fail(cmd, s);
-  const double chunk_m = layout.chunk_size * layout.lattice.cell_size;
-  const double km2 = double(mine.size()) * chunk_m * chunk_m * 1e-6;
-  nlohmann::json report = {{"shard", si},
-                           {"shards", sn},
-                           {"skipped", false},
-                           {"units", mine.size()},
-                           {"units_total", all.size()},
-                           {"cost", before},
-                           {"mixed_chunks", mixed},
-                           {"files", files},
-                           {"area_km2", km2},
-                           {"bytes", {{"mesh", bytes[0]}, {"nav", bytes[1]}, {"voxels", bytes[2]}}},
-                           {"seconds",
-                            {{"total", total.seconds()},
-                             {"plan", plan_seconds},
-                             {"bake_wall", bake_seconds},
-                             {"window_cpu", seconds[0]},
-                             {"mesh_cpu", seconds[1]},
-                             {"nav_cpu", seconds[2]},
-                             {"voxels_cpu", seconds[3]}}}};
-  if (common.json) {
-    std::printf("%s\n", json_text(with_warnings(report)).c_str());
-  } else {
-    std::printf("baked shard %d/%d: %zu of %zu columns, %zu mixed chunks, %zu files (mesh %" PRIu64 " B, nav %" PRIu64
-                " B, voxels %" PRIu64 " B) in %.2f s\n  manifest: %s\n",
-                si, sn, mine.size(), all.size(), mixed, files, bytes[0], bytes[1], bytes[2], total.seconds(),
-                manifest_path.string().c_str());
-  }
+  print_shard_report(plan, t.value(), layout, si, sn, {total.seconds(), plan_seconds, bake_seconds}, manifest_path,
+                     common);
   return kExitSuccess;
 }
 
 // --- Merge ----------------------------------------------------------------------
 
-int run_merge(const BakeArgs& a, const CommonOptions& common) {
-  const std::string cmd = "bake --merge";
-  const fs::path out(a.merge);
+// Errors of the merge, as fail() prints them: a message of its own, or a
+// Status's text (its code named).
+std::string status_text(const Status& s) { return s.to_string(); }
+
+// The shard folders under DIR/shards, by number.
+std::optional<std::string> shard_folders(const fs::path& out, std::map<long long, fs::path>& found) {
   std::error_code ec;
-  if (!fs::is_directory(out / "shards", ec)) return fail(cmd, (out / "shards").string() + ": no shards folder (nothing baked here)");
-  std::map<long long, fs::path> found;
+  if (!fs::is_directory(out / "shards", ec)) return (out / "shards").string() + ": no shards folder (nothing baked here)";
   for (const auto& e : fs::directory_iterator(out / "shards", ec)) {
     const std::string name = e.path().filename().string();
     if (name.empty() || name.find_first_not_of("0123456789") != std::string::npos || name.size() > 9)
-      return fail(cmd, e.path().string() + ": not a shard folder (expected a shard number)");
+      return e.path().string() + ": not a shard folder (expected a shard number)";
     found[std::stoll(name)] = e.path();
   }
-  if (found.empty()) return fail(cmd, (out / "shards").string() + ": no shards");
-  // N from the first manifest found; every other must agree.
+  if (found.empty()) return (out / "shards").string() + ": no shards";
+  return std::nullopt;
+}
+
+// What every shard of one bake agrees on, from the first manifest read.
+struct ShardSet {
   std::string world_id;
   std::vector<std::string> products;
   int n = -1, lods = 1;
   std::string mesh_format;
-  std::vector<nlohmann::json> manifests;
+  std::vector<nlohmann::json> manifests;  // in shard order
+};
+
+// One shard's manifest against the set (the first one sets it), and its files' checksums.
+std::optional<std::string> check_shard_manifest(const nlohmann::json& j, const fs::path& path, long long index,
+                                                ShardSet& set) {
+  const std::string m = (path / "manifest.json").string();
+  if (j.value("format", std::string()) != kShardFormat) return m + ": not a bake shard manifest";
+  const int shards = j.value("shards", -1);
+  if (shards <= 0) return m + ": N = " + std::to_string(shards) + " (the shard count must be at least 1)";
+  if (j.value("shard", -1) != index)
+    return m + " says shard " + std::to_string(j.value("shard", -1)) + ", but lies in folder " + std::to_string(index);
+  if (set.n < 0) {
+    set.n = shards;
+    set.world_id = j.value("world", std::string());
+    set.products = j.value("products", std::vector<std::string>());
+    set.lods = j.value("lods", 1);
+    set.mesh_format = j.value("mesh_format", std::string("glb"));
+  }
+  if (shards != set.n) return m + ": a bake in " + std::to_string(shards) + " shards, the others in " + std::to_string(set.n);
+  if (index >= set.n)
+    return path.string() + ": shard index " + std::to_string(index) + " out of range for " + std::to_string(set.n) +
+           " shards (0 .. " + std::to_string(set.n - 1) + ")";
+  if (j.value("world", std::string()) != set.world_id)
+    return m + ": shard of another world ('" + j.value("world", std::string()) + "', not '" + set.world_id + "')";
+  if (j.value("products", std::vector<std::string>()) != set.products) return m + ": shard of other products";
+  if (j.value("lods", 1) != set.lods)
+    return m + ": a bake of " + std::to_string(j.value("lods", 1)) + " mesh levels, the others of " +
+           std::to_string(set.lods);
+  if (j.value("mesh_format", std::string("glb")) != set.mesh_format)
+    return m + ": a bake of ." + j.value("mesh_format", std::string("glb")) + " meshes, the others of ." + set.mesh_format;
+  if (Status s = check_files(path, j, nullptr); !s.ok()) return status_text(s);
+  return std::nullopt;
+}
+
+// Every shard's manifest, checked; then that no shard is missing.
+std::optional<std::string> read_shard_set(const fs::path& out, const std::map<long long, fs::path>& found,
+                                          ShardSet& set) {
+  std::error_code ec;
   for (const auto& [index, path] : found) {
     if (!fs::exists(path / "manifest.json", ec))
-      return fail(cmd, "shard " + std::to_string(index) + " is not finished: " + (path / "manifest.json").string() +
-                           " is missing (re-run that shard)");
+      return "shard " + std::to_string(index) + " is not finished: " + (path / "manifest.json").string() +
+             " is missing (re-run that shard)";
     Result<nlohmann::json> m = read_json(path / "manifest.json");
-    if (!m.ok()) return fail(cmd, m.status());
-    const nlohmann::json& j = m.value();
-    if (j.value("format", std::string()) != kShardFormat)
-      return fail(cmd, (path / "manifest.json").string() + ": not a bake shard manifest");
-    const int shards = j.value("shards", -1);
-    if (shards <= 0) return fail(cmd, (path / "manifest.json").string() + ": N = " + std::to_string(shards) + " (the shard count must be at least 1)");
-    if (j.value("shard", -1) != index)
-      return fail(cmd, (path / "manifest.json").string() + " says shard " + std::to_string(j.value("shard", -1)) +
-                           ", but lies in folder " + std::to_string(index));
-    if (n < 0) {
-      n = shards;
-      world_id = j.value("world", std::string());
-      products = j.value("products", std::vector<std::string>());
-      lods = j.value("lods", 1);
-      mesh_format = j.value("mesh_format", std::string("glb"));
-    }
-    if (shards != n)
-      return fail(cmd, (path / "manifest.json").string() + ": a bake in " + std::to_string(shards) + " shards, the others in " + std::to_string(n));
-    if (index >= n)
-      return fail(cmd, path.string() + ": shard index " + std::to_string(index) + " out of range for " +
-                           std::to_string(n) + " shards (0 .. " + std::to_string(n - 1) + ")");
-    if (j.value("world", std::string()) != world_id)
-      return fail(cmd, (path / "manifest.json").string() + ": shard of another world ('" + j.value("world", std::string()) +
-                           "', not '" + world_id + "')");
-    if (j.value("products", std::vector<std::string>()) != products)
-      return fail(cmd, (path / "manifest.json").string() + ": shard of other products");
-    if (j.value("lods", 1) != lods)
-      return fail(cmd, (path / "manifest.json").string() + ": a bake of " + std::to_string(j.value("lods", 1)) +
-                           " mesh levels, the others of " + std::to_string(lods));
-    if (j.value("mesh_format", std::string("glb")) != mesh_format)
-      return fail(cmd, (path / "manifest.json").string() + ": a bake of ." + j.value("mesh_format", std::string("glb")) +
-                           " meshes, the others of ." + mesh_format);
-    if (Status s = check_files(path, j, nullptr); !s.ok()) return fail(cmd, s);
-    manifests.push_back(j);
+    if (!m.ok()) return status_text(m.status());
+    if (auto error = check_shard_manifest(m.value(), path, index, set)) return error;
+    set.manifests.push_back(m.value());
   }
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < set.n; ++i)
     if (!found.count(i))
-      return fail(cmd, "shard " + std::to_string(i) + "/" + std::to_string(n) + " is missing (" +
-                           (out / "shards" / std::to_string(i)).string() + "); re-run it before merging");
-  if (Status s = check_same_world(out, world_id, join(products), n, lods, mesh_format); !s.ok()) return fail(cmd, s);
-  // Units in column order across shards (each shard's are contiguous and in order).
-  nlohmann::json units = nlohmann::json::array();
-  size_t files = 0;
-  uint64_t bytes = 0;
-  int64_t units_total = -1;
-  for (int i = 0; i < n; ++i) {
-    const nlohmann::json& j = manifests[size_t(i)];
-    if (units_total < 0) units_total = j.value("units_total", int64_t{0});
-    for (const auto& u : j.at("units")) {
+      return "shard " + std::to_string(i) + "/" + std::to_string(set.n) + " is missing (" +
+             (out / "shards" / std::to_string(i)).string() + "); re-run it before merging";
+  return std::nullopt;
+}
+
+// Each shard's files linked (or copied) to DIR/<name>, its units appended in
+// column order (each shard's are contiguous and in order).
+std::optional<std::string> link_shard_files(const fs::path& out, const ShardSet& set, nlohmann::json& units,
+                                            size_t& files, uint64_t& bytes) {
+  std::error_code ec;
+  for (int i = 0; i < set.n; ++i) {
+    for (const auto& u : set.manifests[size_t(i)].at("units")) {
       units.push_back(u);
       for (const auto& f : u.at("files")) {
         const std::string name = f.at("name").get<std::string>();
-        const fs::path target = out / name;
+        const fs::path target = out / name, source = out / "shards" / std::to_string(i) / name;
         fs::create_directories(target.parent_path(), ec);
         fs::remove(target, ec);
-        fs::create_hard_link(out / "shards" / std::to_string(i) / name, target, ec);
+        fs::create_hard_link(source, target, ec);
         if (ec) {
           ec.clear();
-          fs::copy_file(out / "shards" / std::to_string(i) / name, target, fs::copy_options::overwrite_existing, ec);
-          if (ec) return fail(cmd, target.string() + ": cannot link or copy (" + ec.message() + ")");
+          fs::copy_file(source, target, fs::copy_options::overwrite_existing, ec);
+          if (ec) return target.string() + ": cannot link or copy (" + ec.message() + ")";
         }
         ++files;
         bytes += f.at("bytes").get<uint64_t>();
       }
     }
   }
+  return std::nullopt;
+}
+
+int run_merge(const BakeArgs& a, const CommonOptions& common) {
+  const std::string cmd = "bake --merge";
+  const fs::path out(a.merge);
+  std::map<long long, fs::path> found;
+  if (auto error = shard_folders(out, found)) return fail(cmd, *error);
+  ShardSet set;
+  if (auto error = read_shard_set(out, found, set)) return fail(cmd, *error);
+  if (Status s = check_same_world(out, set.world_id, join(set.products), set.n, set.lods, set.mesh_format); !s.ok())
+    return fail(cmd, s);
+  nlohmann::json units = nlohmann::json::array();
+  size_t files = 0;
+  uint64_t bytes = 0;
+  if (auto error = link_shard_files(out, set, units, files, bytes)) return fail(cmd, *error);
+  const nlohmann::json& first = set.manifests[0];
+  const int64_t units_total = first.value("units_total", int64_t{0});
   if (int64_t(units.size()) != units_total)
     return fail(cmd, "the shards hold " + std::to_string(units.size()) + " columns, the plan " + std::to_string(units_total));
-  const nlohmann::json& first = manifests[0];
   // The index does not depend on N: the same world baked in any number of
   // shards gives the same index.json, and the same files beside it.
   nlohmann::json index = {{"format", kIndexFormat},
-                          {"world", world_id},
-                          {"products", products},
-                          {"lods", first.value("lods", 1)},
-                          {"mesh_format", first.value("mesh_format", std::string("glb"))},
+                          {"world", set.world_id},
+                          {"products", set.products},
+                          {"lods", set.lods},
+                          {"mesh_format", set.mesh_format},
                           {"chunk_size", first.value("chunk_size", 0)},
                           {"cell_size", first.value("cell_size", 0.0)},
                           {"units", units}};
   if (Status s = write_file_atomically((out / "index.json").string(), json_text(index, 1) + "\n"); !s.ok()) return fail(cmd, s);
   if (common.json)
-    std::printf("%s\n", json_text(with_warnings({{"shards", n}, {"units", units.size()}, {"files", files}, {"bytes", bytes}, {"index", (out / "index.json").string()}})).c_str());
+    std::printf("%s\n", json_text(with_warnings({{"shards", set.n}, {"units", units.size()}, {"files", files}, {"bytes", bytes}, {"index", (out / "index.json").string()}})).c_str());
   else
-    std::printf("merged %d shards: %zu columns, %zu files, %" PRIu64 " bytes, every checksum verified\n  index: %s\n", n,
+    std::printf("merged %d shards: %zu columns, %zu files, %" PRIu64 " bytes, every checksum verified\n  index: %s\n", set.n,
                 units.size(), files, bytes, (out / "index.json").string().c_str());
   return kExitSuccess;
 }
