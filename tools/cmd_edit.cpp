@@ -178,60 +178,177 @@ WorldBox brush_box(const Brush& brush) {
   return std::visit(Visitor{}, brush.shape);
 }
 
+// Options that a .ldcs store refuses: it is edited in place, in one commit,
+// and neither meshed nor validated as a whole. Messages are printed as they are.
+Status check_store_edit_options(const EditArgs& a) {
+  if (!a.output.empty()) {
+    return Status(ErrorCode::kInvalidArgument, "-o " + a.output + ": a .ldcs store (" + a.input +
+                                                   ") is edited in place, in one atomic commit; copy it first to "
+                                                   "keep the original");
+  }
+  if (!a.mesh.empty()) {
+    return Status(ErrorCode::kInvalidArgument, "--mesh is for .ldc worlds; contour the edited part of the store " +
+                                                   a.input + " with ldc contour --region");
+  }
+  if (a.validate) return Status(ErrorCode::kInvalidArgument, "--validate is for .ldc worlds, not the store " + a.input);
+  return {};
+}
+
+// An intersect would page (and empty) every chunk of the store, so a script
+// with one is refused before the store opens. The message is printed as it is.
+Status check_store_edit_ops(const EditArgs& a, const std::vector<ScriptEdit>& list) {
+  for (size_t i = 0; i < list.size(); ++i) {
+    if (list[i].edit.op == EditOp::kIntersect) {
+      return Status(ErrorCode::kInvalidArgument,
+                    a.script + ": edit " + std::to_string(i) + " (intersect " + list[i].brush_name +
+                        ") would remove everything outside its brush across the whole store " + a.input +
+                        "; stores take union, subtract and paint");
+    }
+  }
+  return {};
+}
+
+// Groups of edits that share a window: each edit alone, or all with --batch.
+std::vector<std::vector<size_t>> store_edit_groups(size_t edits, bool batch) {
+  std::vector<std::vector<size_t>> groups;
+  for (size_t i = 0; i < edits; ++i) {
+    if (!batch || groups.empty()) groups.emplace_back();
+    groups.back().push_back(i);
+  }
+  return groups;
+}
+
+// The chunks one edit's brush meets. Returns kExitSuccess, or fail()'s code
+// once the error is printed (a brush without finite bounds, a box outside the
+// store's or over the limit).
+int brush_chunks(const SourceLayout& layout, size_t index, const ScriptEdit& e, ChunkRange* chunks) {
+  const std::string what = "edit " + std::to_string(index) + " (" + edit_op_name(e.edit.op) + " " + e.brush_name + ")";
+  // The brush's box grown by two cells (its rasterization covers it plus a cell).
+  const WorldBox box = brush_box(e.edit.brush);
+  const glm::dvec3 grow(2.0 * layout.lattice.cell_size);
+  if (!std::isfinite(box.min.x + box.min.y + box.min.z + box.max.x + box.max.y + box.max.z)) {
+    return fail("edit", what + ": the brush has no finite bounds");
+  }
+  Result<ChunkRange> r = chunks_of_box(layout, box.min - grow, box.max + grow, 0, what);
+  if (!r.ok()) return fail("edit", r.status());
+  *chunks = r.value();
+  return kExitSuccess;
+}
+
+// Every group's window (its brushes' chunks plus one chunk of margin), all
+// bounded before anything is paged. Returns kExitSuccess, or fail()'s code
+// once the error is printed.
+int store_edit_windows(const EditArgs& a, const SourceLayout& layout, const std::vector<ScriptEdit>& list,
+                       const std::vector<std::vector<size_t>>& groups, std::vector<ChunkRange>* windows) {
+  for (const std::vector<size_t>& group : groups) {
+    ChunkRange wanted;
+    for (size_t k = 0; k < group.size(); ++k) {
+      ChunkRange r;
+      if (int code = brush_chunks(layout, group[k], list[group[k]], &r); code != kExitSuccess) return code;
+      wanted = k == 0 ? r : ChunkRange{glm::min(wanted.lo, r.lo), glm::max(wanted.hi, r.hi)};
+    }
+    const std::string what = a.batch ? "the batch's window" : "edit " + std::to_string(group[0]) + "'s window";
+    Result<ChunkRange> window = clip_chunks(layout, wanted, 1, what);
+    if (!window.ok()) return fail("edit", window.status());
+    windows->push_back(window.value());
+  }
+  return kExitSuccess;
+}
+
+// --batch: all edits in one apply_batch on the one window. The message is printed as it is.
+Status apply_store_batch(WorldEditor& editor, const std::vector<ScriptEdit>& list, Context* ctx,
+                         nlohmann::json& report) {
+  std::vector<WorldEditor::Edit> batch;
+  for (const ScriptEdit& e : list) batch.push_back(e.edit);
+  ScopedTimer t(nullptr, "");
+  Result<EditReceipt> r = editor.apply_batch(batch, ctx);
+  if (!r.ok()) {
+    return Status(r.status().code(), "the batch failed: " + r.status().message() + "; nothing committed");
+  }
+  for (size_t i = 0; i < list.size(); ++i) report["edits"].push_back(edit_json(i, list[i]));
+  report["batch"] = {{"chunks_changed", r.value().changed_chunks.size()}, {"ms", 1000.0 * t.seconds()}};
+  return {};
+}
+
+// Edit `i` alone on its window. The message is printed as it is.
+Status apply_store_edit(WorldEditor& editor, const std::vector<ScriptEdit>& list, size_t i,
+                        ScriptProgress& progress, nlohmann::json& report) {
+  ScopedTimer t(nullptr, "");
+  Result<EditReceipt> r = editor.apply(list[i].edit.brush, list[i].edit.op, progress.at(i));
+  if (!r.ok()) {
+    return Status(r.status().code(), "edit " + std::to_string(i) + " (" + edit_op_name(list[i].edit.op) + " " +
+                                         list[i].brush_name + ") failed: " + r.status().message() +
+                                         "; nothing committed");
+  }
+  nlohmann::json entry = edit_json(i, list[i]);
+  entry["chunks_changed"] = r.value().changed_chunks.size();
+  entry["ms"] = 1000.0 * t.seconds();
+  report["edits"].push_back(entry);
+  return {};
+}
+
+// One group: its window paged in, its edits applied, the chunks they changed
+// put back to the pager (later windows see them). Page and edit times add up
+// in report["seconds"]. Returns kExitSuccess, or fail()'s code once the error is printed.
+int edit_store_window(const EditArgs& a, const std::vector<ScriptEdit>& list, const std::vector<size_t>& group,
+                      const ChunkRange& range, PagedWorld& paged, ProgressBar& bar, ScriptProgress& progress,
+                      nlohmann::json& report) {
+  ScopedTimer page(nullptr, "");
+  Result<World> window = paged.window(range.lo, range.hi, bar.context());
+  report["seconds"]["page"] = report["seconds"]["page"].get<double>() + page.seconds();
+  if (!window.ok()) return fail("edit", window.status());
+  ScopedTimer apply(nullptr, "");
+  WorldEditor editor(std::move(window).value());
+  Status applied = a.batch ? apply_store_batch(editor, list, bar.context(), report)
+                           : apply_store_edit(editor, list, group[0], progress, report);
+  if (!applied.ok()) return fail("edit", applied.message());
+  std::vector<glm::ivec3> changed;
+  for (const DirtyChunk& d : editor.take_dirty()) changed.push_back(d.chunk);
+  if (Status s = paged.put(editor.world(), changed); !s.ok()) return fail("edit", s);
+  report["seconds"]["edits"] = report["seconds"]["edits"].get<double>() + apply.seconds();
+  return kExitSuccess;
+}
+
+// The commit's counts and the log after it.
+void add_commit_report(nlohmann::json& report, size_t dirty, const PagedWorld& paged, size_t paged_slots,
+                       const ChunkLogStats& st) {
+  report["chunks_committed"] = dirty;
+  report["chunks_paged"] = paged.stats().page_ins;
+  report["window_slots"] = paged_slots;
+  report["log"] = {{"commits", st.commits}, {"sequence", st.sequence}, {"live_chunks", st.live_chunks},
+                   {"file_bytes", st.file_bytes}, {"dead_fraction", st.dead_fraction()}};
+  report["ok"] = true;
+}
+
+void print_store_edit_report(const nlohmann::json& report, const std::string& input, size_t dirty,
+                             const ChunkLogStats& st) {
+  print_edit_lines(report);
+  if (dirty == 0) {
+    std::printf("no chunk changed: nothing committed to %s\n", input.c_str());
+  } else {
+    std::printf("committed %zu chunks to %s (commit %llu; %llu live chunks, %llu bytes)\n", dirty, input.c_str(),
+                static_cast<unsigned long long>(st.sequence), static_cast<unsigned long long>(st.live_chunks),
+                static_cast<unsigned long long>(st.file_bytes));
+  }
+  print_seconds(report["seconds"]);
+}
+
 // A store is edited in place: each edit (all of them with --batch) runs on a
 // window of the chunks its brush meets plus one chunk of margin, the chunks
 // it changed go back to the pager (later windows see them), and the end
 // commits them all to the log as one commit (atomic: all or none).
 int run_store_edit(const EditArgs& a, const CommonOptions& common) {
-  if (!a.output.empty()) {
-    return fail("edit", "-o " + a.output + ": a .ldcs store (" + a.input +
-                            ") is edited in place, in one atomic commit; copy it first to keep the original");
-  }
-  if (!a.mesh.empty()) {
-    return fail("edit", "--mesh is for .ldc worlds; contour the edited part of the store " + a.input +
-                            " with ldc contour --region");
-  }
-  if (a.validate) return fail("edit", "--validate is for .ldc worlds, not the store " + a.input);
+  if (Status s = check_store_edit_options(a); !s.ok()) return fail("edit", s.message());
   Result<std::vector<ScriptEdit>> edits = read_edit_script(a.script);  // a bad script fails before the store opens
   if (!edits.ok()) return fail("edit", edits.status());
   const std::vector<ScriptEdit>& list = edits.value();
-  for (size_t i = 0; i < list.size(); ++i) {
-    if (list[i].edit.op == EditOp::kIntersect) {
-      return fail("edit", a.script + ": edit " + std::to_string(i) + " (intersect " + list[i].brush_name +
-                              ") would remove everything outside its brush across the whole store " + a.input +
-                              "; stores take union, subtract and paint");
-    }
-  }
+  if (Status s = check_store_edit_ops(a, list); !s.ok()) return fail("edit", s.message());
   Result<Store> store = open_store(a.input);
   if (!store.ok()) return fail("edit", store.status());
-  const SourceLayout& layout = store->source->layout();
-  // Groups of edits that share a window: each edit alone, or all with --batch.
-  std::vector<std::vector<size_t>> groups;
-  for (size_t i = 0; i < list.size(); ++i) {
-    if (!a.batch || groups.empty()) groups.emplace_back();
-    groups.back().push_back(i);
-  }
+  const std::vector<std::vector<size_t>> groups = store_edit_groups(list.size(), a.batch);
   std::vector<ChunkRange> windows;
-  for (const std::vector<size_t>& group : groups) {  // every window bounded before anything is paged
-    ChunkRange wanted;
-    for (size_t k = 0; k < group.size(); ++k) {
-      const ScriptEdit& e = list[group[k]];
-      const std::string what = "edit " + std::to_string(group[k]) + " (" + edit_op_name(e.edit.op) + " " +
-                               e.brush_name + ")";
-      // The brush's box grown by two cells (its rasterization covers it plus a cell).
-      const WorldBox box = brush_box(e.edit.brush);
-      const glm::dvec3 grow(2.0 * layout.lattice.cell_size);
-      if (!std::isfinite(box.min.x + box.min.y + box.min.z + box.max.x + box.max.y + box.max.z)) {
-        return fail("edit", what + ": the brush has no finite bounds");
-      }
-      Result<ChunkRange> r = chunks_of_box(layout, box.min - grow, box.max + grow, 0, what);
-      if (!r.ok()) return fail("edit", r.status());
-      wanted = k == 0 ? r.value() : ChunkRange{glm::min(wanted.lo, r->lo), glm::max(wanted.hi, r->hi)};
-    }
-    const std::string what = a.batch ? "the batch's window" : "edit " + std::to_string(group[0]) + "'s window";
-    Result<ChunkRange> window = clip_chunks(layout, wanted, 1, what);
-    if (!window.ok()) return fail("edit", window.status());
-    windows.push_back(window.value());
+  if (int code = store_edit_windows(a, store->source->layout(), list, groups, &windows); code != kExitSuccess) {
+    return code;
   }
   ProgressBar bar(!common.quiet);
   nlohmann::json report = {{"input", a.input}, {"script", a.script}, {"output", a.input},
@@ -240,38 +357,11 @@ int run_store_edit(const EditArgs& a, const CommonOptions& common) {
   ScriptProgress progress(bar.context(), list.size());
   size_t paged_slots = 0;
   for (size_t g = 0; g < groups.size(); ++g) {
-    ScopedTimer page(nullptr, "");
-    Result<World> window = paged.window(windows[g].lo, windows[g].hi, bar.context());
-    report["seconds"]["page"] = report["seconds"]["page"].get<double>() + page.seconds();
-    if (!window.ok()) return fail("edit", window.status());
-    paged_slots += size_t(windows[g].slots());
-    ScopedTimer apply(nullptr, "");
-    WorldEditor editor(std::move(window).value());
-    if (a.batch) {
-      std::vector<WorldEditor::Edit> batch;
-      for (const ScriptEdit& e : list) batch.push_back(e.edit);
-      ScopedTimer t(nullptr, "");
-      Result<EditReceipt> r = editor.apply_batch(batch, bar.context());
-      if (!r.ok()) return fail("edit", "the batch failed: " + r.status().message() + "; nothing committed");
-      for (size_t i = 0; i < list.size(); ++i) report["edits"].push_back(edit_json(i, list[i]));
-      report["batch"] = {{"chunks_changed", r.value().changed_chunks.size()}, {"ms", 1000.0 * t.seconds()}};
-    } else {
-      const size_t i = groups[g][0];
-      ScopedTimer t(nullptr, "");
-      Result<EditReceipt> r = editor.apply(list[i].edit.brush, list[i].edit.op, progress.at(i));
-      if (!r.ok()) {
-        return fail("edit", "edit " + std::to_string(i) + " (" + edit_op_name(list[i].edit.op) + " " +
-                                list[i].brush_name + ") failed: " + r.status().message() + "; nothing committed");
-      }
-      nlohmann::json entry = edit_json(i, list[i]);
-      entry["chunks_changed"] = r.value().changed_chunks.size();
-      entry["ms"] = 1000.0 * t.seconds();
-      report["edits"].push_back(entry);
+    if (int code = edit_store_window(a, list, groups[g], windows[g], paged, bar, progress, report);
+        code != kExitSuccess) {
+      return code;
     }
-    std::vector<glm::ivec3> changed;
-    for (const DirtyChunk& d : editor.take_dirty()) changed.push_back(d.chunk);
-    if (Status s = paged.put(editor.world(), changed); !s.ok()) return fail("edit", s);
-    report["seconds"]["edits"] = report["seconds"]["edits"].get<double>() + apply.seconds();
+    paged_slots += size_t(windows[g].slots());
   }
   const size_t dirty = paged.stats().dirty;
   ScopedTimer save(nullptr, "");
@@ -280,24 +370,11 @@ int run_store_edit(const EditArgs& a, const CommonOptions& common) {
   bar.finish();
   if (!s.ok()) return fail("edit", s);  // the log keeps its previous commit
   const ChunkLogStats st = store->log->stats();
-  report["chunks_committed"] = dirty;
-  report["chunks_paged"] = paged.stats().page_ins;
-  report["window_slots"] = paged_slots;
-  report["log"] = {{"commits", st.commits}, {"sequence", st.sequence}, {"live_chunks", st.live_chunks},
-                   {"file_bytes", st.file_bytes}, {"dead_fraction", st.dead_fraction()}};
-  report["ok"] = true;
+  add_commit_report(report, dirty, paged, paged_slots, st);
   if (common.json) {
     std::printf("%s\n", json_text(report).c_str());
   } else {
-    print_edit_lines(report);
-    if (dirty == 0) {
-      std::printf("no chunk changed: nothing committed to %s\n", a.input.c_str());
-    } else {
-      std::printf("committed %zu chunks to %s (commit %llu; %llu live chunks, %llu bytes)\n", dirty,
-                  a.input.c_str(), static_cast<unsigned long long>(st.sequence),
-                  static_cast<unsigned long long>(st.live_chunks), static_cast<unsigned long long>(st.file_bytes));
-    }
-    print_seconds(report["seconds"]);
+    print_store_edit_report(report, a.input, dirty, st);
   }
   return kExitSuccess;
 }
