@@ -1,6 +1,8 @@
 // coarsen(): see ldc/lod.h.
 #include "ldc/lod.h"
 
+#include <algorithm>
+#include <cmath>
 #include <memory>
 #include <string>
 
@@ -65,6 +67,44 @@ Result<World> coarsen(const World& world, int level) {
   });
   for (size_t i = 0; i < mixed.size(); ++i) out.set_chunk(mixed[i], std::move(coarse[i]));
   return out;
+}
+
+Status check_lod_bands(const LodBands& bands) {
+  if (!std::isfinite(bands.hysteresis) || bands.hysteresis < 0.0) {
+    return Status(ErrorCode::kInvalidArgument, "lod bands: hysteresis " + std::to_string(bands.hysteresis) +
+                                                   " must be finite and >= 0");
+  }
+  double previous = 0.0;
+  for (size_t k = 0; k < bands.start.size(); ++k) {
+    const double start = bands.start[k];
+    if (!std::isfinite(start) || start <= previous) {
+      return Status(ErrorCode::kInvalidArgument, "lod bands: start[" + std::to_string(k) + "] = " +
+                                                     std::to_string(start) + " must be finite and above " +
+                                                     std::to_string(previous));
+    }
+    if (start - previous <= 2.0 * bands.hysteresis) {
+      return Status(ErrorCode::kInvalidArgument, "lod bands: the band before start[" + std::to_string(k) +
+                                                     "] is not wider than twice the hysteresis (" +
+                                                     std::to_string(bands.hysteresis) + " m)");
+    }
+    previous = start;
+  }
+  return {};
+}
+
+int lod_level(const LodBands& bands, double distance, int level) {
+  if (!check_lod_bands(bands).ok()) return level;
+  const int levels = int(bands.start.size()) + 1;
+  level = std::clamp(level, 0, levels - 1);
+  while (level + 1 < levels && distance >= bands.start[size_t(level)] + bands.hysteresis) ++level;
+  while (level > 0 && distance < bands.start[size_t(level - 1)] - bands.hysteresis) --level;
+  return level;
+}
+
+double chunk_distance(const Lattice& lattice, int chunk_size, const glm::ivec3& chunk, const glm::dvec3& point) {
+  const glm::dvec3 lo = lattice.node_position(chunk * chunk_size);
+  const glm::dvec3 hi = lattice.node_position((chunk + 1) * chunk_size);
+  return glm::length(point - glm::clamp(point, lo, hi));
 }
 
 }  // namespace ldc

@@ -13,10 +13,13 @@
 // Chunks keep their coordinates, so the level-k mesh of chunk c is the mesh
 // of chunk c of the coarse world. Chunks of one level meet without cracks;
 // chunks of different levels do not (the seam between levels is not built).
+// lod_level() picks a chunk's level by its distance to the camera.
 //
 // Thread safety: coarsen only reads `world`; the result shares no chunk
 // data with it.
 #pragma once
+
+#include <vector>
 
 #include "ldc/status.h"
 #include "ldc/world.h"
@@ -30,5 +33,27 @@ int max_lod_level(int chunk_size);
 // The world through every 2^level-th ray (level 0: a copy). kInvalidArgument
 // for a level below 0 or above max_lod_level(world.chunk_size()).
 Result<World> coarsen(const World& world, int level);
+
+// --- Choosing a chunk's level by distance, with hysteresis --------------------
+
+// Level k is meant from distance start[k - 1] on (start[0] begins level 1),
+// so start.size() + 1 levels. A chunk changes level only once it is
+// `hysteresis` past a band's edge, so one moving along an edge does not
+// flip between two levels every frame.
+struct LodBands {
+  std::vector<double> start;  // [Units: m] [Limit: finite, > 0, increasing]
+  double hysteresis = 2.0;    // [Units: m] [Limit: finite, >= 0, below half of each band's width]
+};
+// kInvalidArgument naming the first bad value.
+Status check_lod_bands(const LodBands& bands);
+
+// The level of a chunk now at `level` (clamped to the bands' levels), at
+// `distance` from the camera: coarser only at start[k - 1] + hysteresis or
+// farther, finer only below start[k] - hysteresis. Bands that fail
+// check_lod_bands give `level` unchanged.
+int lod_level(const LodBands& bands, double distance, int level);
+
+// Distance from `point` to the nearest point of a chunk's box (0 inside) [Units: m].
+double chunk_distance(const Lattice& lattice, int chunk_size, const glm::ivec3& chunk, const glm::dvec3& point);
 
 }  // namespace ldc

@@ -3,6 +3,7 @@
 // with about 4^-k of the triangles.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 
 #include "contour/contour.h"
@@ -144,5 +145,48 @@ TEST(Lod, ChunkMeshesOfACoarseWindowAreWellFormedAndItsFacesAreRefused) {
     EXPECT_NE(face.status().message().find("inside at the world box face"), std::string::npos) << face.status().message();
   }
 }
+// --- The level by distance -------------------------------------------------
+
+TEST(Lod, LevelFollowsDistanceWithHysteresis) {
+  const LodBands bands{.start = {50.0, 100.0}, .hysteresis = 5.0};
+  ASSERT_TRUE(check_lod_bands(bands).ok());
+  EXPECT_EQ(lod_level(bands, 10.0, 0), 0);
+  EXPECT_EQ(lod_level(bands, 54.0, 0), 0);   // inside the dead band: stays
+  EXPECT_EQ(lod_level(bands, 55.0, 0), 1);
+  EXPECT_EQ(lod_level(bands, 46.0, 1), 1);   // coming back: stays until 45
+  EXPECT_EQ(lod_level(bands, 44.9, 1), 0);
+  EXPECT_EQ(lod_level(bands, 300.0, 0), 2);  // several levels at once
+  EXPECT_EQ(lod_level(bands, 0.0, 2), 0);
+  EXPECT_EQ(lod_level(bands, 70.0, 7), 1);   // a level past the bands is clamped first
+}
+
+TEST(Lod, ACameraSwayingOnABandEdgeDoesNotFlipTheLevel) {
+  const LodBands bands{.start = {50.0}, .hysteresis = 2.0};
+  int level = lod_level(bands, 60.0, 0), flips = 0;
+  for (int frame = 0; frame < 200; ++frame) {
+    const int next = lod_level(bands, 50.0 + 1.5 * std::sin(0.3 * frame), level);  // +-1.5 m around the edge
+    flips += next != level;
+    level = next;
+  }
+  EXPECT_EQ(flips, 0);
+  EXPECT_EQ(level, 1);
+}
+
+TEST(Lod, BadBandsAreRefusedByName) {
+  EXPECT_NE(check_lod_bands({.start = {50.0, 40.0}}).message().find("start[1] = 40"), std::string::npos);
+  EXPECT_NE(check_lod_bands({.start = {std::nan("")}}).message().find("start[0]"), std::string::npos);
+  EXPECT_NE(check_lod_bands({.start = {50.0}, .hysteresis = -1.0}).message().find("hysteresis"), std::string::npos);
+  EXPECT_NE(check_lod_bands({.start = {3.0}, .hysteresis = 2.0}).message().find("twice the hysteresis"),
+            std::string::npos);
+  EXPECT_EQ(lod_level({.start = {50.0, 40.0}}, 1000.0, 1), 1);  // bad bands change nothing
+}
+
+TEST(Lod, ChunkDistanceIsToTheNearestPointOfItsBox) {
+  const Lattice lattice{.origin = {1.0, 2.0, 3.0}, .cell_size = 0.5};  // chunks of 8 cells: 4 m
+  EXPECT_DOUBLE_EQ(chunk_distance(lattice, 8, {0, 0, 0}, {2.0, 3.0, 4.0}), 0.0);  // inside
+  EXPECT_DOUBLE_EQ(chunk_distance(lattice, 8, {1, 0, 0}, {2.0, 3.0, 4.0}), 3.0);  // box x from 5 m
+  EXPECT_DOUBLE_EQ(chunk_distance(lattice, 8, {0, 0, 0}, {8.0, 10.0, 4.0}), 5.0);  // (3, 4, 0) away
+}
+
 }  // namespace
 }  // namespace ldc
