@@ -66,10 +66,10 @@ Result<std::string> read_file(const std::string& path, uint64_t max_bytes, const
     return io_error(path, "cannot open", error);
   }
   std::string bytes;
-  std::vector<char> buffer(size_t(1) << 16);
-  size_t got = std::fread(buffer.data(), 1, buffer.size(), file);
+  char buffer[1 << 16];
+  size_t got = std::fread(buffer, 1, sizeof buffer, file);
   if (check_head) {
-    if (Status head = check_head(std::string_view(buffer.data(), got), uint64_t(st.st_size)); !head.ok()) {
+    if (Status head = check_head(std::string_view(buffer, got), uint64_t(st.st_size)); !head.ok()) {
       std::fclose(file);
       return head;
     }
@@ -77,12 +77,12 @@ Result<std::string> read_file(const std::string& path, uint64_t max_bytes, const
   try {
     bytes.reserve(size_t(st.st_size));
     // Still bounded while reading: a file can grow after the fstat.
-    for (; got > 0; got = std::fread(buffer.data(), 1, buffer.size(), file)) {
+    for (; got > 0; got = std::fread(buffer, 1, sizeof buffer, file)) {
       if (bytes.size() + got > max_bytes) {
         std::fclose(file);
         return over_load_limit(path, max_bytes);
       }
-      bytes.append(buffer.data(), got);
+      bytes.append(buffer, got);
     }
   } catch (const std::bad_alloc&) {
     std::fclose(file);

@@ -48,9 +48,9 @@ struct LodBands {
 Status check_lod_bands(const LodBands& bands);
 
 // The level of a chunk now at `level` (clamped to the bands' levels), at
-// `distance` from the camera: coarser only at start[k - 1] + hysteresis or
-// farther, finer only below start[k] - hysteresis. Bands that fail
-// check_lod_bands give `level` unchanged.
+// `distance` from the camera: it moves up to level k + 1 only at start[k] +
+// hysteresis or farther, and down from level k only below start[k - 1] -
+// hysteresis. Bands that fail check_lod_bands give `level` unchanged.
 int lod_level(const LodBands& bands, double distance, int level);
 
 // Distance from `point` to the nearest point of a chunk's box (0 inside) [Units: m].

@@ -71,6 +71,9 @@ std::string quoted(std::string_view token) {
 
 Status parse_error(std::string message) { return {ErrorCode::kParseError, std::move(message)}; }
 
+// The PLY parser's first-line refusal, also given from a file's first block.
+constexpr const char* kNotPly = "not a PLY file (the first line is not 'ply')";
+
 Status no_triangles(std::string_view name) { return parse_error(concat(name, ": no triangles")); }
 
 // ------------------------------------------------------------- text scanning
@@ -564,7 +567,7 @@ class PlyHeaderParser {
       std::string_view keyword;
       tokens.next(keyword);
       if (line_ == 1) {
-        if (keyword != "ply") return error("not a PLY file (the first line is not 'ply')");
+        if (keyword != "ply") return error(kNotPly);
         continue;
       }
       if (keyword == "end_header") {
@@ -1344,7 +1347,7 @@ Status check_mesh_file_head(MeshFormat format, std::string_view head, uint64_t s
       std::string_view keyword;
       tokens.next(keyword);
       if (keyword == "ply") return Status();
-      return parse_error(concat(path, ":1: not a PLY file (the first line is not 'ply')"));
+      return parse_error(concat(path, ":1: ", kNotPly));
     }
     case MeshFormat::kStl:
       return looks_like_text_stl(head, size) ? Status() : binary_stl_size_error(head, size, path);

@@ -738,9 +738,8 @@ int run_bake(const BakeArgs& a, const CommonOptions& common) {
 
 // --- Merge ----------------------------------------------------------------------
 
-// Errors of the merge, as fail() prints them: a message of its own, or a
-// Status's text (its code named).
-std::string status_text(const Status& s) { return s.to_string(); }
+// The merge's helpers return their error as fail() prints it: a message of
+// their own, or a Status's to_string() (its code named).
 
 // The shard folders under DIR/shards, by number.
 std::optional<std::string> shard_folders(const fs::path& out, std::map<long long, fs::path>& found) {
@@ -793,7 +792,7 @@ std::optional<std::string> check_shard_manifest(const nlohmann::json& j, const f
            std::to_string(set.lods);
   if (j.value("mesh_format", std::string("glb")) != set.mesh_format)
     return m + ": a bake of ." + j.value("mesh_format", std::string("glb")) + " meshes, the others of ." + set.mesh_format;
-  if (Status s = check_files(path, j, nullptr); !s.ok()) return status_text(s);
+  if (Status s = check_files(path, j, nullptr); !s.ok()) return s.to_string();
   return std::nullopt;
 }
 
@@ -806,7 +805,7 @@ std::optional<std::string> read_shard_set(const fs::path& out, const std::map<lo
       return "shard " + std::to_string(index) + " is not finished: " + (path / "manifest.json").string() +
              " is missing (re-run that shard)";
     Result<nlohmann::json> m = read_json(path / "manifest.json");
-    if (!m.ok()) return status_text(m.status());
+    if (!m.ok()) return m.status().to_string();
     if (auto error = check_shard_manifest(m.value(), path, index, set)) return error;
     set.manifests.push_back(m.value());
   }

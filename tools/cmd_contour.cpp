@@ -20,7 +20,8 @@ struct ContourArgs {
   int lod = 0;         // contour only: every 2^lod-th ray (ldc/lod.h)
 };
 
-// The world at level a.lod (itself at 0), the seconds it took under "coarsen".
+// The world at level `lod` (itself at 0); the seconds coarsening took go to
+// report["seconds"]["coarsen"].
 Result<World> at_level(World world, int lod, nlohmann::json& report) {
   if (lod == 0) return world;
   ScopedTimer t(nullptr, "");
