@@ -21,10 +21,13 @@
 //   4. only the triangles around moved vertices are tested again (the pair
 //      finder of mesh_quality, restricted to them); pairs whose triangles
 //      did not move are carried over.
-// It stops when no pair is left, nothing moved, or after max_rounds. The
-// topology never changes; boundary and non-manifold vertices never move.
+// It stops when no pair is left, nothing moved, or after max_rounds. Then
+// small closed components still intersecting themselves (specks around one
+// or two lattice nodes, see contour.h) are removed. Otherwise the topology
+// never changes; boundary and non-manifold vertices never move.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -194,12 +197,96 @@ std::vector<detail::TrianglePair> pairs_after(const ContourMesh& mesh, const Tab
   return pairs;
 }
 
+// Connected components of the triangles (sharing a vertex joins them): the
+// component of each triangle, numbered from 0.
+std::vector<uint32_t> triangle_components(const ContourMesh& mesh, const Table& tris, uint32_t* count) {
+  constexpr uint32_t kNone = std::numeric_limits<uint32_t>::max();
+  std::vector<uint32_t> component(mesh.triangle_count(), kNone);
+  std::vector<uint32_t> stack;
+  uint32_t next = 0;
+  for (uint32_t seed = 0; seed < mesh.triangle_count(); ++seed) {
+    if (component[seed] != kNone) continue;
+    component[seed] = next;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const glm::uvec3 t = mesh.triangles[stack.back()];
+      stack.pop_back();
+      for (int k = 0; k < 3; ++k)
+        for (size_t i = tris.begin(t[k]); i < tris.end(t[k]); ++i)
+          if (component[tris.items[i]] == kNone) component[tris.items[i]] = next, stack.push_back(tris.items[i]);
+    }
+    ++next;
+  }
+  *count = next;
+  return component;
+}
+
+// Removes the triangles whose `gone` is set, then the vertices no triangle
+// uses any more (were used before), keeping the order of the rest.
+void remove_triangles(ContourMesh& mesh, const std::vector<uint8_t>& gone) {
+  std::vector<uint8_t> used_before(mesh.vertex_count(), 0), used_after(mesh.vertex_count(), 0);
+  size_t kept = 0;
+  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
+    for (int k = 0; k < 3; ++k) (gone[t] ? used_before : used_after)[mesh.triangles[t][k]] = 1;
+    if (gone[t]) continue;
+    mesh.triangles[kept] = mesh.triangles[t];
+    if (!mesh.triangle_material.empty()) mesh.triangle_material[kept] = mesh.triangle_material[t];
+    ++kept;
+  }
+  mesh.triangles.resize(kept);
+  if (!mesh.triangle_material.empty()) mesh.triangle_material.resize(kept);
+  std::vector<uint32_t> remap(mesh.vertex_count());
+  uint32_t next = 0;
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+    remap[v] = next;
+    if (used_before[v] && !used_after[v]) continue;  // only the removed triangles used it
+    mesh.positions[next] = mesh.positions[v];
+    if (mesh.normals.size() == mesh.vertex_count()) mesh.normals[next] = mesh.normals[v];
+    if (mesh.vertex_material.size() == mesh.vertex_count()) mesh.vertex_material[next] = mesh.vertex_material[v];
+    ++next;
+  }
+  if (mesh.normals.size() == mesh.positions.size()) mesh.normals.resize(next);
+  if (mesh.vertex_material.size() == mesh.positions.size()) mesh.vertex_material.resize(next);
+  mesh.positions.resize(next);
+  for (glm::uvec3& t : mesh.triangles) t = glm::uvec3(remap[t.x], remap[t.y], remap[t.z]);
+}
+
+// Removes the closed components of at most max_vertices vertices that hold
+// a triangle of `pairs`; the pairs left are those of other components.
+void remove_specks(ContourMesh& mesh, const Table& tris, const Neighbourhood& nb, int max_vertices,
+                   std::vector<detail::TrianglePair>& pairs, UntangleMeshStats& stats) {
+  uint32_t count = 0;
+  const std::vector<uint32_t> component = triangle_components(mesh, tris, &count);
+  std::vector<uint32_t> vertices(count, 0);
+  std::vector<uint8_t> closed(count, 1);  // every vertex inside a closed fan
+  for (uint32_t v = 0; v < mesh.vertex_count(); ++v) {
+    if (tris.begin(v) == tris.end(v)) continue;
+    const uint32_t c = component[tris.items[tris.begin(v)]];
+    ++vertices[c];
+    closed[c] = closed[c] && nb.movable[v];
+  }
+  std::vector<uint8_t> speck(count, 0);
+  for (const auto& [a, b] : pairs)
+    for (uint32_t t : {a, b})
+      if (closed[component[t]] && vertices[component[t]] <= size_t(max_vertices)) speck[component[t]] = 1;
+  std::vector<uint8_t> gone(mesh.triangle_count(), 0);
+  for (uint32_t t = 0; t < mesh.triangle_count(); ++t) gone[t] = speck[component[t]];
+  for (uint8_t s : speck) stats.specks_removed += s;
+  if (stats.specks_removed == 0) return;
+  for (uint8_t g : gone) stats.speck_triangles_removed += g;
+  std::erase_if(pairs, [&](const detail::TrianglePair& p) { return gone[p.first] || gone[p.second]; });
+  remove_triangles(mesh, gone);
+}
+
 }  // namespace
 
 Status check_untangle_mesh_options(const UntangleMeshOptions& o) {
   if (o.max_rounds < 0 || o.max_rounds > 1000)
     return Status(ErrorCode::kInvalidArgument,
                   "untangle_mesh: max_rounds = " + std::to_string(o.max_rounds) + " must be in [0, 1000]");
+  if (o.max_speck_vertices < 0 || o.max_speck_vertices > 64)
+    return Status(ErrorCode::kInvalidArgument, "untangle_mesh: max_speck_vertices = " +
+                                                   std::to_string(o.max_speck_vertices) + " must be in [0, 64]");
   return {};
 }
 
@@ -234,8 +321,10 @@ Result<UntangleMeshStats> untangle_mesh(ContourMesh& mesh, const UntangleMeshOpt
     for (uint32_t v : moved) ever_moved[v] = 1;
     pairs = pairs_after(mesh, tris, moved, pairs);
   }
-  stats.pairs_after = pairs.size();
   for (uint8_t m : ever_moved) stats.vertices_moved += m;
+  if (!pairs.empty() && options.max_speck_vertices > 0 && options.max_rounds > 0)
+    remove_specks(mesh, tris, nb, options.max_speck_vertices, pairs, stats);
+  stats.pairs_after = pairs.size();
   return stats;
 }
 

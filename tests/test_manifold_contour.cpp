@@ -387,6 +387,91 @@ TEST(UntangleMesh, RefusesBadOptionsAndIndices) {
   EXPECT_TRUE(untangle_mesh(m, {.max_rounds = 0}).ok());
 }
 
+// A speck: the blob of 8 vertices and 12 triangles that dual contouring makes
+// around one lattice node, crumpled through itself (taken from a spot-and-
+// spot intersection at 256 cells, where untangle_mesh's rounds never opened
+// it), beside an octahedron that is clean.
+ContourMesh speck_beside_an_octahedron() {
+  ContourMesh m;
+  const glm::dvec3 speck[8] = {
+      {0.7604316308643404, 0.10203821713626293, 0.50153252940717064},
+      {0.7604316308643404, 0.10309079674245958, 0.49974827928811605},
+      {0.75979646738813233, 0.10302902986051243, 0.49999770565077029},
+      {0.7610025332342405, 0.1028613681679813, 0.49993593033737316},
+      {0.7604316308643404, 0.10309079674245958, 0.50014083398325537},
+      {0.76094154965122063, 0.10218079060172203, 0.50113942763210795},
+      {0.76103490587093092, 0.10322557701937352, 0.49929179211158559},
+      {0.76060452251754596, 0.1045156201539833, 0.50159140721546924}};
+  const glm::vec3 speck_normals[8] = {{0.319f, -0.832f, -0.455f}, {0.319f, -0.832f, -0.455f},
+                                      {-0.179f, -0.852f, -0.492f}, {0.348f, -0.823f, -0.448f},
+                                      {0.936f, -0.324f, -0.136f},  {0.938f, -0.319f, -0.133f},
+                                      {0.938f, -0.319f, -0.133f},  {0.986f, 0.120f, 0.117f}};
+  const glm::uvec3 speck_triangles[12] = {{0, 1, 2}, {3, 0, 2}, {1, 3, 2}, {0, 4, 1}, {3, 5, 0}, {0, 5, 4},
+                                          {1, 4, 6}, {1, 6, 3}, {3, 6, 5}, {6, 7, 5}, {5, 7, 4}, {4, 7, 6}};
+  // The octahedron first, so that its vertices keep their indices.
+  const glm::dvec3 octahedron[6] = {{2, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0, -1, 0}, {0, 0, -1}, {-2, 0, 0}};
+  for (const glm::dvec3& p : octahedron) {
+    m.positions.push_back(p);
+    m.normals.push_back(glm::vec3(glm::normalize(p)));
+    m.vertex_material.push_back(7);
+  }
+  for (uint32_t k = 0; k < 4; ++k) {
+    const uint32_t a = 1 + k, b = 1 + (k + 1) % 4;
+    m.triangles.push_back({0, a, b});
+    m.triangles.push_back({5, b, a});
+  }
+  for (size_t i = 0; i < 8; ++i) {
+    m.positions.push_back(speck[i]);
+    m.normals.push_back(speck_normals[i]);
+    m.vertex_material.push_back(3);
+  }
+  for (const glm::uvec3& t : speck_triangles) m.triangles.push_back(t + glm::uvec3(6));
+  m.triangle_material.assign(8, 7);
+  m.triangle_material.resize(20, 3);
+  return m;
+}
+
+TEST(UntangleMesh, RemovesATangledSpeckTheRoundsLeave) {
+  ContourMesh m = speck_beside_an_octahedron();
+  ASSERT_GT(mesh_quality(m).self_intersecting_pairs, 0u);
+  const ContourMesh before = m;
+  const UntangleMeshStats stats = untangle_mesh(m, {.max_rounds = 3}).value();
+  EXPECT_EQ(stats.pairs_after, 0u);
+  EXPECT_EQ(stats.specks_removed, 1u);
+  EXPECT_EQ(stats.speck_triangles_removed, 12u);
+  // The octahedron is left, exactly, with its normals and materials.
+  ASSERT_EQ(m.triangle_count(), 8u);
+  ASSERT_EQ(m.vertex_count(), 6u);
+  for (size_t t = 0; t < 8; ++t) EXPECT_EQ(m.triangles[t], before.triangles[t]) << t;
+  for (size_t v = 0; v < 6; ++v) {
+    EXPECT_EQ(m.positions[v], before.positions[v]) << v;
+    EXPECT_EQ(m.normals[v], before.normals[v]) << v;
+    EXPECT_EQ(m.vertex_material[v], 7) << v;
+  }
+  EXPECT_EQ(m.triangle_material, std::vector<uint16_t>(8, 7));
+  expect_closed(m, "octahedron after the speck went");
+}
+
+TEST(UntangleMesh, KeepsATangledSpeckWhenRemovalIsOffOrItIsLarger) {
+  for (int limit : {0, 7}) {  // off; below the speck's 8 vertices
+    ContourMesh m = speck_beside_an_octahedron();
+    const UntangleMeshStats stats = untangle_mesh(m, {.max_rounds = 3, .max_speck_vertices = limit}).value();
+    EXPECT_GT(stats.pairs_after, 0u) << limit;
+    EXPECT_EQ(stats.specks_removed, 0u) << limit;
+    EXPECT_EQ(m.triangle_count(), 20u) << limit;
+    EXPECT_EQ(stats.pairs_after, mesh_quality(m).self_intersecting_pairs) << limit;
+  }
+}
+
+TEST(UntangleMesh, RefusesABadSpeckLimit) {
+  ContourMesh m = speck_beside_an_octahedron();
+  for (int limit : {-1, 65}) {
+    const Result<UntangleMeshStats> r = untangle_mesh(m, {.max_speck_vertices = limit});
+    ASSERT_FALSE(r.ok()) << limit;
+    EXPECT_NE(r.status().message().find("max_speck_vertices"), std::string::npos);
+  }
+}
+
 // The count untangle_mesh leaves is exact (the tools report it instead of
 // searching again): equal to a full search, also where it gives up early.
 TEST(UntangleMesh, PairsLeftEqualAFullSearch) {

@@ -123,8 +123,12 @@ void print_report(const nlohmann::json& j) {
   }
   if (j.contains("untangle") && j["untangle"]["pairs_before"].get<size_t>() > 0) {
     const auto& u = j["untangle"];
-    std::printf("  untangled: %zu self-intersecting pairs -> %zu, %zu vertices moved\n",
+    std::printf("  untangled: %zu self-intersecting pairs -> %zu, %zu vertices moved",
                 u["pairs_before"].get<size_t>(), u["pairs_after"].get<size_t>(), u["vertices_moved"].get<size_t>());
+    if (u["specks_removed"].get<size_t>() > 0)
+      std::printf("; tangled specks removed: %zu (%zu triangles)", u["specks_removed"].get<size_t>(),
+                  u["speck_triangles_removed"].get<size_t>());
+    std::printf("\n");
   }
   // %.3g: a sliver of 0.004 degrees (not degenerate) must not read "0.0".
   std::printf("  min angle %.3g deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
@@ -144,7 +148,9 @@ Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report) 
   report["untangle"] = {{"pairs_before", s.pairs_before},
                         {"pairs_after", s.pairs_after},
                         {"vertices_moved", s.vertices_moved},
-                        {"rounds", s.rounds}};
+                        {"rounds", s.rounds},
+                        {"specks_removed", s.specks_removed},
+                        {"speck_triangles_removed", s.speck_triangles_removed}};
   return {};
 }
 
