@@ -2,7 +2,9 @@
 // normals unused for placement. Each cube's polygons are the loops of its
 // sheets (detail/cell_sheets.h, the table dual contouring uses too: faces
 // with two diagonal inside corners separate them, the same from both cubes
-// sharing the face), fanned into triangles.
+// sharing the face, except where both cubes would link the face's two
+// segments: that face is joined from both sides, as dual contouring does),
+// fanned into triangles.
 //
 // Welding: a vertex is a lattice edge's crossing, so it is named by the edge
 // (its lower node and axis). Chunks are meshed in parallel, each keeping the
@@ -46,9 +48,8 @@ class CubeMesher {
       : w_(w), r_(r), cell_lo_(cell_lo), part_(out), out_(out.mesh), ids_(out.ids) {}
 
   void cube(const glm::ivec3& cell) {
-    unsigned inside = 0;
-    for (int c = 0; c < 8; ++c) inside |= unsigned(r_.inside(cell + corner(c))) << c;
-    const detail::CellSheets& sheets = detail::cell_sheets(inside);
+    const unsigned inside = inside_corners(cell);
+    const detail::CellSheets& sheets = detail::cell_sheets(inside, joined_faces(cell, inside));
     for (int s = 0; s < sheets.count; ++s) {
       uint32_t loop[12];
       const int n = sheets.loop_size[s];
@@ -61,6 +62,30 @@ class CubeMesher {
   }
 
  private:
+  unsigned inside_corners(const glm::ivec3& cell) const {
+    unsigned inside = 0;
+    for (int c = 0; c < 8; ++c) inside |= unsigned(r_.inside(cell + corner(c))) << c;
+    return inside;
+  }
+
+  // The faces whose cubes on both sides would link both of the face's
+  // segments, joined from both sides as dual contouring joins them
+  // (detail::face_links_both_segments). Otherwise both cubes' loops pass
+  // through both segments, and their fans can both use the chord between
+  // the same two crossings: an edge of four triangles. The region holds one
+  // node more on every side than the cubes read, for the cubes across.
+  unsigned joined_faces(const glm::ivec3& cell, unsigned inside) const {
+    unsigned joined = 0;
+    for (int face = 0; face < 6; ++face) {
+      if (!detail::face_links_both_segments(inside, face)) continue;  // false on faces that are not ambiguous
+      const int axis = face / 2, side = face % 2;
+      glm::ivec3 across = cell;
+      across[axis] += side ? 1 : -1;
+      if (detail::face_links_both_segments(inside_corners(across), 2 * axis + 1 - side)) joined |= 1u << face;
+    }
+    return joined;
+  }
+
   uint32_t vertex(const glm::ivec3& cell, int slot) {
     const int axis = detail::cell_edge_axis(slot);
     const glm::ivec3 node = cell + detail::cell_edge_offset(slot);
@@ -108,7 +133,7 @@ Result<ContourMesh> marching_cubes(const World& world, Context* ctx) {
     for (int k = 0; k < 8; ++k) quiet = quiet && world.chunk_kind(chunks[i] + corner(k)) == world.chunk_kind(chunks[i]);
     if (quiet && world.chunk_kind(chunks[i]) != ChunkKind::kMixed) return;
     detail::Region region;
-    region.load(world, cell_lo, cell_hi + 1, cell_lo, cell_hi);
+    region.load(world, cell_lo - 1, cell_hi + 2, cell_lo, cell_hi);
     if (region.uniform()) return;
     CubeMesher mesher(world, region, cell_lo, parts[i]);
     for (int z = cell_lo.z; z < cell_hi.z; ++z)

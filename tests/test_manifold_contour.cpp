@@ -149,6 +149,37 @@ TEST(ManifoldContour, RandomBlocksAreClosedManifolds) {
   EXPECT_LT(untangled_pairs * 2, tangled_pairs) << untangled_pairs << " pairs left of " << tangled_pairs;
 }
 
+// Marching cubes on random blocks like those above: its polygons follow the
+// same sheets, and were fanned into triangles without the joined faces, so a
+// tunnel through an ambiguous face gave a chord between two crossings that
+// both cubes' fans used (an edge of four triangles). Each block once inside
+// one chunk and once across the seam at node 8 between chunks of 8 cells
+// (the cube across a face then belongs to another chunk).
+TEST(ManifoldContour, MarchingCubesOnRandomBlocksIsAClosedManifold) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> value(-1.0, 1.0);
+  size_t nonmanifold = 0, meshes = 0;
+  for (int k : {2, 3}) {  // k^3 random nodes: (k - 1)^3 cells of random corners
+    for (int trial = 0; trial < 400; ++trial) {
+      std::vector<double> block(size_t(k * k * k));
+      for (double& v : block) v = value(rng);
+      for (int lo : {1, 7}) {  // nodes lo .. lo + k - 1; 7 and 8 lie on both sides of the seam
+        const int n = lo + k + 1;
+        std::vector<double> values(size_t(n * n * n), 1.0);
+        for (int z = 0; z < k; ++z)
+          for (int y = 0; y < k; ++y)
+            for (int x = 0; x < k; ++x) values[size_t(((lo + z) * n + lo + y) * n + lo + x)] = block[size_t((z * k + y) * k + x)];
+        const ContourMesh m = marching_cubes(field_world(n, values)).value();
+        expect_closed_manifold(m, std::to_string(k) + "^3 trial " + std::to_string(trial) + " at " + std::to_string(lo));
+        const MeshQuality q = mesh_quality(m);
+        nonmanifold += q.nonmanifold_edges + q.nonmanifold_vertices > 0;
+        ++meshes;
+      }
+    }
+  }
+  EXPECT_EQ(nonmanifold, 0u) << nonmanifold << " of " << meshes << " meshes have a non-manifold edge";
+}
+
 TEST(ManifoldContour, ThinSlabAndTouchingBoxesAreClosedManifolds) {
   // A slab one node layer thick: every cell around it holds two sheets.
   {
