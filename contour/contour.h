@@ -439,7 +439,10 @@ Result<SimplifyStats> simplify_mesh(ContourMesh& mesh, const SimplifyOptions& op
 // vertices of every intersecting triangle pair move to the centroid of their
 // neighbours, a move that would turn a triangle over is halved or undone,
 // and further rounds widen the moved area by a ring of neighbours, until no
-// pair is left (contour/untangle_mesh.cpp). Boundary and non-manifold
+// pair is left (contour/untangle_mesh.cpp). It returns the positions of the
+// round that left the fewest pairs: on a simplified mesh, whose vertices'
+// neighbours lie far apart, a round can make more pairs than it clears
+// (an edited landscape's 57 pairs became 90). Boundary and non-manifold
 // vertices never move. Pairs are those mesh_quality counts.
 // The tools contour without the local round, simplify, then run it.
 //
@@ -458,6 +461,13 @@ Result<SimplifyStats> simplify_mesh(ContourMesh& mesh, const SimplifyOptions& op
 struct UntangleMeshOptions {
   // Rounds before giving up [Limit: 0..1000]; 0 only counts the pairs.
   int max_rounds = 50;
+  // Farthest a vertex may end from where it started [Units: world]
+  // [Limit: >= 0, finite]; 0 = no limit. On a simplified mesh the centroid
+  // of a vertex's neighbours can lie many cells off the surface (rounds
+  // that widened the moved area moved an edited landscape's vertices so far
+  // that its volume fell by a third): the tools limit the moves there to
+  // one cell h, which also let that case converge.
+  double max_move = 0.0;
   // Largest closed component still intersecting itself after the rounds
   // that is removed [Limit: 0..64] [Units: vertices]. 12 takes specks of one
   // and two lattice nodes; 0 removes nothing.
@@ -466,8 +476,8 @@ struct UntangleMeshOptions {
 
 struct UntangleMeshStats {
   size_t pairs_before = 0;    // intersecting pairs found first
-  size_t pairs_after = 0;     // left at the end (0 unless it gave up)
-  size_t vertices_moved = 0;  // vertices that moved at least once
+  size_t pairs_after = 0;     // left at the end (0 unless it gave up); never above pairs_before
+  size_t vertices_moved = 0;  // vertices not where they started
   size_t rounds = 0;
   size_t specks_removed = 0;           // closed components removed (see above)
   size_t speck_triangles_removed = 0;  // their triangles

@@ -21,7 +21,8 @@
 //   4. only the triangles around moved vertices are tested again (the pair
 //      finder of mesh_quality, restricted to them); pairs whose triangles
 //      did not move are carried over.
-// It stops when no pair is left, nothing moved, or after max_rounds. Then
+// It stops when no pair is left, nothing moved, or after max_rounds, and
+// returns the positions of the round that left the fewest pairs. Then
 // small closed components still intersecting themselves (specks around one
 // or two lattice nodes, see contour.h) are removed. Otherwise the topology
 // never changes; boundary and non-manifold vertices never move.
@@ -150,8 +151,11 @@ bool fan_keeps_side(const ContourMesh& mesh, const Table& tris, const std::vecto
 }
 
 // One round of umbrella moves; returns the vertices that moved.
+// A vertex goes at most max_move (0: no limit) from where it started
+// (`original`): a target further away is pulled back onto that sphere.
 std::vector<uint32_t> smooth(ContourMesh& mesh, const Table& tris, const Neighbourhood& nb,
-                             const std::vector<glm::dvec3>& facing, const std::vector<uint32_t>& marked) {
+                             const std::vector<glm::dvec3>& facing, const std::vector<uint32_t>& marked,
+                             const std::vector<glm::dvec3>& original, double max_move) {
   const std::vector<glm::dvec3> before = mesh.positions;
   std::vector<uint32_t> moving;
   std::vector<glm::dvec3> step;
@@ -160,6 +164,11 @@ std::vector<uint32_t> smooth(ContourMesh& mesh, const Table& tris, const Neighbo
     glm::dvec3 centroid(0.0);
     for (size_t j = nb.neighbours.begin(v); j < nb.neighbours.end(v); ++j) centroid += before[nb.neighbours.items[j]];
     centroid /= double(nb.neighbours.end(v) - nb.neighbours.begin(v));
+    if (max_move > 0.0) {
+      const glm::dvec3 away = centroid - original[v];
+      const double length = glm::length(away);
+      if (length > max_move) centroid = original[v] + away * (max_move / length);
+    }
     if (centroid == before[v]) continue;
     moving.push_back(v);
     step.push_back(centroid - before[v]);
@@ -284,6 +293,9 @@ Status check_untangle_mesh_options(const UntangleMeshOptions& o) {
   if (o.max_rounds < 0 || o.max_rounds > 1000)
     return Status(ErrorCode::kInvalidArgument,
                   "untangle_mesh: max_rounds = " + std::to_string(o.max_rounds) + " must be in [0, 1000]");
+  if (!(o.max_move >= 0.0 && std::isfinite(o.max_move)))
+    return Status(ErrorCode::kInvalidArgument,
+                  "untangle_mesh: max_move = " + std::to_string(o.max_move) + " must be finite and >= 0");
   if (o.max_speck_vertices < 0 || o.max_speck_vertices > 64)
     return Status(ErrorCode::kInvalidArgument, "untangle_mesh: max_speck_vertices = " +
                                                    std::to_string(o.max_speck_vertices) + " must be in [0, 64]");
@@ -304,24 +316,33 @@ Result<UntangleMeshStats> untangle_mesh(ContourMesh& mesh, const UntangleMeshOpt
   const Table tris = vertex_triangles(mesh);
   const Neighbourhood nb = neighbourhood(mesh, tris);
   const std::vector<glm::dvec3> face = facing(mesh);
-  std::vector<uint8_t> ever_moved(mesh.vertex_count(), 0);
   const std::vector<glm::dvec3> original = mesh.positions;
+  // The round that left the fewest pairs (on a coarse, simplified mesh a
+  // move to the centroid of far neighbours can make more than it clears):
+  // what is returned if the last round is worse.
+  size_t best = pairs.size();
+  std::vector<detail::TrianglePair> best_pairs = pairs;
+  std::vector<glm::dvec3> best_positions;  // empty while the start is the best
   for (int round = 0; round < options.max_rounds && !pairs.empty(); ++round) {
     if (ctx && ctx->cancelled()) {
       mesh.positions = original;
       return Status(ErrorCode::kCancelled, "untangle_mesh: cancelled");
     }
     const std::vector<uint32_t> marked = marked_vertices(mesh, pairs, nb.neighbours, std::min(round, kMaxRing));
-    const std::vector<uint32_t> moved = smooth(mesh, tris, nb, face, marked);
+    const std::vector<uint32_t> moved = smooth(mesh, tris, nb, face, marked, original, options.max_move);
     ++stats.rounds;
     if (moved.empty()) {
       if (round >= kMaxRing) break;
       continue;  // a wider ring may still help
     }
-    for (uint32_t v : moved) ever_moved[v] = 1;
     pairs = pairs_after(mesh, tris, moved, pairs);
+    if (pairs.size() < best) best = pairs.size(), best_pairs = pairs, best_positions = mesh.positions;
   }
-  for (uint8_t m : ever_moved) stats.vertices_moved += m;
+  if (pairs.size() > best) {
+    mesh.positions = best_positions.empty() ? original : std::move(best_positions);
+    pairs = std::move(best_pairs);
+  }
+  for (size_t v = 0; v < mesh.vertex_count(); ++v) stats.vertices_moved += mesh.positions[v] != original[v];
   if (!pairs.empty() && options.max_speck_vertices > 0 && options.max_rounds > 0)
     remove_specks(mesh, tris, nb, options.max_speck_vertices, pairs, stats);
   stats.pairs_after = pairs.size();

@@ -17,6 +17,7 @@
 #include "contour/detail/cell_sheets.h"
 #include "csg/csg.h"
 #include "ldc/build.h"
+#include "ldc/terrain.h"
 #include "test_util.h"
 
 namespace ldc {
@@ -501,6 +502,62 @@ TEST(UntangleMesh, RefusesABadSpeckLimit) {
     ASSERT_FALSE(r.ok()) << limit;
     EXPECT_NE(r.status().message().find("max_speck_vertices"), std::string::npos);
   }
+}
+
+// A 16 x 16 m landscape with a noisy blob built on it and a capsule and a
+// box dug out (from a random edit sweep), contoured without untangling and
+// simplified within 0.2 cells: 57 pairs on 18,578 triangles, whose vertices'
+// neighbours lie up to several cells apart.
+ContourMesh simplified_edited_landscape() {
+  WorldEditor editor(build_terrain({.size_x = 16.0, .size_y = 16.0}).value());
+  const NoiseSphere noise{.radius = 3.6178786175651436, .amplitude = 0.39004796915377893,
+                          .frequency = 3.5185602171389974, .seed = 91};
+  EXPECT_TRUE(editor.apply(Brush::noisy_sphere({7.820176366664272, 4.934169822770745, 6.412026629803773}, noise),
+                           EditOp::kUnion).ok());
+  EXPECT_TRUE(editor.apply(Brush::capsule({7.564472193573003, 3.608441125566202, 7.286627989256111},
+                                          {3.758102796398994, 5.915715817312617, 10.871381927426572}, 1.060657906462726),
+                           EditOp::kSubtract).ok());
+  Brush box = Brush::box({10.72898066720736, 4.0474706928201005, 3.0536153412559637},
+                         {1.3875002568473913, 0.733382463822995, 2.75337400064785});
+  const glm::dvec3 centre(10.72898066720736, 4.0474706928201005, 3.0536153412559637);
+  box.transform() = glm::translate(glm::dmat4(1.0), centre) *
+                    glm::rotate(glm::dmat4(1.0), glm::radians(63.728415102301),
+                                glm::normalize(glm::dvec3(-0.9371973276954111, -0.5064789022136653, 0.4277349478706338))) *
+                    glm::translate(glm::dmat4(1.0), -centre) * box.transform();
+  EXPECT_TRUE(editor.apply(box, EditOp::kSubtract).ok());
+  ContourMesh m = contour_world(editor.world(), {.untangle = false}).value();
+  EXPECT_TRUE(simplify_mesh(m, {.max_error = 0.04}).ok());
+  return m;
+}
+
+// Its rounds, widening the moved area, carried vertices towards far
+// centroids: 57 pairs became 90 and the volume fell by a third. The round
+// with the fewest pairs is what comes back.
+TEST(UntangleMesh, EndsAtTheRoundThatLeftTheFewestPairs) {
+  ContourMesh m = simplified_edited_landscape();
+  const MeshQuality before = mesh_quality(m);
+  ASSERT_GT(before.self_intersecting_pairs, 0u);
+  const UntangleMeshStats stats = untangle_mesh(m).value();
+  EXPECT_LE(stats.pairs_after, stats.pairs_before);
+  EXPECT_EQ(stats.pairs_after, mesh_quality(m).self_intersecting_pairs);
+  EXPECT_NEAR(mesh_quality(m).volume, before.volume, 0.01 * before.volume);
+}
+
+// With moves limited to one cell (as the tools run it on simplified
+// meshes) no vertex ends further than that from where it began, and the
+// same mesh comes out clean.
+TEST(UntangleMesh, MovesNoVertexFurtherThanMaxMove) {
+  ContourMesh m = simplified_edited_landscape();
+  const std::vector<glm::dvec3> start = m.positions;
+  const double volume = mesh_quality(m).volume;
+  const UntangleMeshStats stats = untangle_mesh(m, {.max_move = 0.2}).value();
+  EXPECT_EQ(stats.pairs_after, 0u);
+  EXPECT_GT(stats.vertices_moved, 0u);
+  double farthest = 0.0;
+  for (size_t v = 0; v < m.vertex_count(); ++v) farthest = std::max(farthest, glm::length(m.positions[v] - start[v]));
+  EXPECT_LE(farthest, 0.2 * (1.0 + 1e-12));
+  EXPECT_NEAR(mesh_quality(m).volume, volume, 0.05 * volume);  // 2% measured: one-cell moves of large triangles
+  EXPECT_FALSE(untangle_mesh(m, {.max_move = -1.0}).ok());
 }
 
 // The count untangle_mesh leaves is exact (the tools report it instead of

@@ -88,6 +88,42 @@ Status simplify_output(const World& w, const MeshOutputArgs& a, Context* ctx, Co
   return {};
 }
 
+size_t pairs_left(const nlohmann::json& report) { return report["untangle"]["pairs_after"].get<size_t>(); }
+
+// Simplifies, then untangles (cheap: few pairs are left on few triangles),
+// moving no vertex further than one cell h. Where that leaves pairs
+// (untangle_mesh moves vertices towards the centroid of their neighbours,
+// which lie far apart on a simplified mesh), starts again from the uniform
+// mesh: untangled first, where the moves are small,
+// then simplified (which never adds a pair), then untangled again. The
+// result with fewer pairs is kept; report["untangle_retry"] says what the
+// second way gave.
+Status simplify_and_untangle(const World& w, const MeshOutputArgs& a, Context* ctx, ContourMesh& mesh,
+                             nlohmann::json& report) {
+  ContourMesh uniform = mesh;
+  if (Status s = simplify_output(w, a, ctx, mesh, report); !s.ok()) return s;
+  if (Status s = untangle_output(ctx, mesh, report, {.max_move = w.lattice().cell_size}); !s.ok()) return s;
+  if (pairs_left(report) == 0) return {};
+  ScopedTimer t(nullptr, "");
+  nlohmann::json retry;
+  if (Status s = untangle_output(ctx, uniform, retry); !s.ok()) return s;
+  const nlohmann::json first = retry["untangle"];
+  if (Status s = simplify_output(w, a, ctx, uniform, retry); !s.ok()) return s;
+  if (Status s = untangle_output(ctx, uniform, retry); !s.ok()) return s;
+  const bool better = pairs_left(retry) < pairs_left(report);
+  report["untangle_retry"] = {{"uniform_pairs_before", first["pairs_before"]},
+                              {"uniform_pairs_after", first["pairs_after"]},
+                              {"pairs_after", pairs_left(retry)},
+                              {"used", better},
+                              {"simplified_pairs_after", pairs_left(report)}};
+  report["seconds"]["untangle_retry"] = t.seconds();
+  if (!better) return {};
+  mesh = std::move(uniform);
+  report["simplify"] = retry["simplify"];
+  report["untangle"] = retry["untangle"];
+  return {};
+}
+
 // Contours, simplifies (with --max-error > 0) and untangles (dual
 // contouring with untangling on), timing each step.
 Result<ContourMesh> mesh_world(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats& stats,
@@ -96,10 +132,14 @@ Result<ContourMesh> mesh_world(const World& w, const MeshOutputArgs& a, Context*
   Result<ContourMesh> mesh = run_method(w, a, ctx, &stats);
   report["seconds"]["contour"] = t.seconds();
   if (!mesh.ok()) return mesh;
-  if (a.max_error_cells > 0.0)
+  const bool untangle = a.method != "mc" && a.config.untangle;
+  if (a.max_error_cells > 0.0 && untangle) {
+    if (Status s = simplify_and_untangle(w, a, ctx, mesh.value(), report); !s.ok()) return s;
+  } else if (a.max_error_cells > 0.0) {
     if (Status s = simplify_output(w, a, ctx, mesh.value(), report); !s.ok()) return s;
-  if (a.method != "mc" && a.config.untangle)
+  } else if (untangle) {
     if (Status s = untangle_output(ctx, mesh.value(), report); !s.ok()) return s;
+  }
   return mesh;
 }
 
@@ -130,6 +170,13 @@ void print_report(const nlohmann::json& j) {
                   u["speck_triangles_removed"].get<size_t>());
     std::printf("\n");
   }
+  if (j.contains("untangle_retry")) {
+    const auto& r = j["untangle_retry"];
+    std::printf("  %s: the simplified mesh kept %zu pairs; untangled before simplifying (%zu -> %zu), then %zu\n",
+                r["used"].get<bool>() ? "retried" : "retried in vain", r["simplified_pairs_after"].get<size_t>(),
+                r["uniform_pairs_before"].get<size_t>(), r["uniform_pairs_after"].get<size_t>(),
+                r["pairs_after"].get<size_t>());
+  }
   // %.3g: a sliver of 0.004 degrees (not degenerate) must not read "0.0".
   std::printf("  min angle %.3g deg; histogram (10 deg bins):", q["min_angle_deg"].get<double>());
   for (const auto& b : q["min_angle_histogram_10deg"]) std::printf(" %zu", b.get<size_t>());
@@ -139,9 +186,9 @@ void print_report(const nlohmann::json& j) {
 
 }  // namespace
 
-Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report) {
+Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report, const UntangleMeshOptions& options) {
   ScopedTimer u(nullptr, "");
-  Result<UntangleMeshStats> untangled = untangle_mesh(mesh, {}, ctx);
+  Result<UntangleMeshStats> untangled = untangle_mesh(mesh, options, ctx);
   report["seconds"]["untangle"] = u.seconds();
   if (!untangled.ok()) return untangled.status();
   const UntangleMeshStats& s = untangled.value();
