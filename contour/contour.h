@@ -494,4 +494,28 @@ Status check_untangle_mesh_options(const UntangleMeshOptions& options);
 Result<UntangleMeshStats> untangle_mesh(ContourMesh& mesh, const UntangleMeshOptions& options = {},
                                         Context* ctx = nullptr);
 
+// --- Simplified and untangled: what the tools run --------------------------------
+//
+// simplify_mesh, then untangle_mesh with `untangle` (the tools cap its
+// max_move at one cell h; few pairs are left on few triangles, so this is
+// cheap). Where pairs remain, it starts again from the mesh as given:
+// untangle_mesh without the cap (moves are small on a uniform mesh),
+// simplify_mesh (which never adds a pair), untangle_mesh with `untangle`
+// again, and keeps the result with fewer pairs. Costs a copy of the mesh;
+// the second way runs only when the first leaves pairs. Errors: those of
+// simplify_mesh and untangle_mesh (the mesh is then unchanged, or as the
+// failing step left it on cancellation).
+struct SimplifyUntangleStats {
+  SimplifyStats simplify;              // of the result kept
+  UntangleMeshStats untangle;          // its last untangling
+  bool retried = false;                // the first way left pairs
+  bool retry_used = false;             // the second way left fewer: its result is kept
+  size_t first_pairs_after = 0;        // pairs the first way left
+  UntangleMeshStats uniform_untangle;  // the second way's first step (when retried)
+  double simplify_seconds = 0.0;       // all simplify_mesh calls
+  double untangle_seconds = 0.0;       // all untangle_mesh calls
+};
+Result<SimplifyUntangleStats> simplify_and_untangle(ContourMesh& mesh, const SimplifyOptions& simplify,
+                                                    const UntangleMeshOptions& untangle, Context* ctx = nullptr);
+
 }  // namespace ldc

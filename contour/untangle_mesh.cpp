@@ -349,4 +349,51 @@ Result<UntangleMeshStats> untangle_mesh(ContourMesh& mesh, const UntangleMeshOpt
   return stats;
 }
 
+namespace {
+
+// simplify_mesh then untangle_mesh on `mesh`, adding their times to `stats`.
+Status simplify_then_untangle(ContourMesh& mesh, const SimplifyOptions& simplify, const UntangleMeshOptions& untangle,
+                              Context* ctx, SimplifyUntangleStats& stats) {
+  ScopedTimer s(nullptr, "");
+  Result<SimplifyStats> simple = simplify_mesh(mesh, simplify, ctx);
+  stats.simplify_seconds += s.seconds();
+  if (!simple.ok()) return simple.status();
+  stats.simplify = simple.value();
+  ScopedTimer u(nullptr, "");
+  Result<UntangleMeshStats> untangled = untangle_mesh(mesh, untangle, ctx);
+  stats.untangle_seconds += u.seconds();
+  if (!untangled.ok()) return untangled.status();
+  stats.untangle = untangled.value();
+  return {};
+}
+
+}  // namespace
+
+Result<SimplifyUntangleStats> simplify_and_untangle(ContourMesh& mesh, const SimplifyOptions& simplify,
+                                                    const UntangleMeshOptions& untangle, Context* ctx) {
+  if (Status s = check_untangle_mesh_options(untangle); !s.ok()) return s;
+  SimplifyUntangleStats stats;
+  ContourMesh uniform = mesh;
+  if (Status s = simplify_then_untangle(mesh, simplify, untangle, ctx, stats); !s.ok()) return s;
+  stats.first_pairs_after = stats.untangle.pairs_after;
+  if (stats.first_pairs_after == 0) return stats;
+  stats.retried = true;
+  UntangleMeshOptions uncapped = untangle;
+  uncapped.max_move = 0.0;
+  ScopedTimer u(nullptr, "");
+  Result<UntangleMeshStats> first = untangle_mesh(uniform, uncapped, ctx);
+  stats.untangle_seconds += u.seconds();
+  if (!first.ok()) return first.status();
+  stats.uniform_untangle = first.value();
+  SimplifyUntangleStats second = stats;
+  if (Status s = simplify_then_untangle(uniform, simplify, untangle, ctx, second); !s.ok()) return s;
+  stats.simplify_seconds = second.simplify_seconds, stats.untangle_seconds = second.untangle_seconds;
+  if (second.untangle.pairs_after >= stats.first_pairs_after) return stats;
+  stats.retry_used = true;
+  stats.simplify = second.simplify;
+  stats.untangle = second.untangle;
+  mesh = std::move(uniform);
+  return stats;
+}
+
 }  // namespace ldc

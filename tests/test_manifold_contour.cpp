@@ -508,7 +508,7 @@ TEST(UntangleMesh, RefusesABadSpeckLimit) {
 // box dug out (from a random edit sweep), contoured without untangling and
 // simplified within 0.2 cells: 57 pairs on 18,578 triangles, whose vertices'
 // neighbours lie up to several cells apart.
-ContourMesh simplified_edited_landscape() {
+ContourMesh uniform_edited_landscape() {
   WorldEditor editor(build_terrain({.size_x = 16.0, .size_y = 16.0}).value());
   const NoiseSphere noise{.radius = 3.6178786175651436, .amplitude = 0.39004796915377893,
                           .frequency = 3.5185602171389974, .seed = 91};
@@ -525,7 +525,11 @@ ContourMesh simplified_edited_landscape() {
                                 glm::normalize(glm::dvec3(-0.9371973276954111, -0.5064789022136653, 0.4277349478706338))) *
                     glm::translate(glm::dmat4(1.0), -centre) * box.transform();
   EXPECT_TRUE(editor.apply(box, EditOp::kSubtract).ok());
-  ContourMesh m = contour_world(editor.world(), {.untangle = false}).value();
+  return contour_world(editor.world(), {.untangle = false}).value();
+}
+
+ContourMesh simplified_edited_landscape() {
+  ContourMesh m = uniform_edited_landscape();
   EXPECT_TRUE(simplify_mesh(m, {.max_error = 0.04}).ok());
   return m;
 }
@@ -558,6 +562,37 @@ TEST(UntangleMesh, MovesNoVertexFurtherThanMaxMove) {
   EXPECT_LE(farthest, 0.2 * (1.0 + 1e-12));
   EXPECT_NEAR(mesh_quality(m).volume, volume, 0.05 * volume);  // 2% measured: one-cell moves of large triangles
   EXPECT_FALSE(untangle_mesh(m, {.max_move = -1.0}).ok());
+}
+
+// What the tools run: simplified, then untangled with one-cell moves, which
+// clears that mesh in one way.
+TEST(SimplifyAndUntangle, OneWayWhenTheCappedRoundsClearEveryPair) {
+  ContourMesh m = uniform_edited_landscape();
+  const size_t uniform = m.triangle_count();
+  const SimplifyUntangleStats stats = simplify_and_untangle(m, {.max_error = 0.04}, {.max_move = 0.2}).value();
+  EXPECT_FALSE(stats.retried);
+  EXPECT_EQ(stats.untangle.pairs_after, 0u);
+  EXPECT_EQ(mesh_quality(m).self_intersecting_pairs, 0u);
+  EXPECT_EQ(stats.simplify.triangles_after, m.triangle_count());
+  EXPECT_LT(m.triangle_count(), uniform / 2);
+}
+
+// Moves too small to open anything leave pairs on the simplified mesh: the
+// second way (the uniform mesh untangled, simplified, untangled) is taken.
+TEST(SimplifyAndUntangle, StartsAgainFromTheUniformMeshWhenPairsRemain) {
+  ContourMesh m = uniform_edited_landscape();
+  const size_t uniform_pairs = mesh_quality(m).self_intersecting_pairs;
+  const SimplifyUntangleStats stats = simplify_and_untangle(m, {.max_error = 0.04}, {.max_move = 1e-9}).value();
+  EXPECT_TRUE(stats.retried);
+  EXPECT_GT(stats.first_pairs_after, 0u);
+  EXPECT_EQ(stats.uniform_untangle.pairs_before, uniform_pairs);
+  EXPECT_EQ(stats.uniform_untangle.pairs_after, 0u);
+  EXPECT_TRUE(stats.retry_used);
+  EXPECT_EQ(stats.untangle.pairs_after, 0u);
+  const MeshQuality q = mesh_quality(m);
+  EXPECT_TRUE(q.closed()) << quality_failures(q);
+  EXPECT_EQ(stats.simplify.triangles_after, m.triangle_count());
+  EXPECT_FALSE(simplify_and_untangle(m, {.max_error = 0.04}, {.max_move = -1.0}).ok());
 }
 
 // The count untangle_mesh leaves is exact (the tools report it instead of

@@ -88,39 +88,36 @@ Status simplify_output(const World& w, const MeshOutputArgs& a, Context* ctx, Co
   return {};
 }
 
-size_t pairs_left(const nlohmann::json& report) { return report["untangle"]["pairs_after"].get<size_t>(); }
+nlohmann::json untangle_json(const UntangleMeshStats& s) {
+  return {{"pairs_before", s.pairs_before},
+          {"pairs_after", s.pairs_after},
+          {"vertices_moved", s.vertices_moved},
+          {"rounds", s.rounds},
+          {"specks_removed", s.specks_removed},
+          {"speck_triangles_removed", s.speck_triangles_removed}};
+}
 
-// Simplifies, then untangles (cheap: few pairs are left on few triangles),
-// moving no vertex further than one cell h. Where that leaves pairs
-// (untangle_mesh moves vertices towards the centroid of their neighbours,
-// which lie far apart on a simplified mesh), starts again from the uniform
-// mesh: untangled first, where the moves are small,
-// then simplified (which never adds a pair), then untangled again. The
-// result with fewer pairs is kept; report["untangle_retry"] says what the
-// second way gave.
-Status simplify_and_untangle(const World& w, const MeshOutputArgs& a, Context* ctx, ContourMesh& mesh,
-                             nlohmann::json& report) {
-  ContourMesh uniform = mesh;
-  if (Status s = simplify_output(w, a, ctx, mesh, report); !s.ok()) return s;
-  if (Status s = untangle_output(ctx, mesh, report, {.max_move = w.lattice().cell_size}); !s.ok()) return s;
-  if (pairs_left(report) == 0) return {};
-  ScopedTimer t(nullptr, "");
-  nlohmann::json retry;
-  if (Status s = untangle_output(ctx, uniform, retry); !s.ok()) return s;
-  const nlohmann::json first = retry["untangle"];
-  if (Status s = simplify_output(w, a, ctx, uniform, retry); !s.ok()) return s;
-  if (Status s = untangle_output(ctx, uniform, retry); !s.ok()) return s;
-  const bool better = pairs_left(retry) < pairs_left(report);
-  report["untangle_retry"] = {{"uniform_pairs_before", first["pairs_before"]},
-                              {"uniform_pairs_after", first["pairs_after"]},
-                              {"pairs_after", pairs_left(retry)},
-                              {"used", better},
-                              {"simplified_pairs_after", pairs_left(report)}};
-  report["seconds"]["untangle_retry"] = t.seconds();
-  if (!better) return {};
-  mesh = std::move(uniform);
-  report["simplify"] = retry["simplify"];
-  report["untangle"] = retry["untangle"];
+// simplify_and_untangle (contour/contour.h) within --max-error, with
+// untangling's moves capped at one cell h; report["untangle_retry"] when
+// the first way left pairs.
+Status simplify_and_untangle_output(const World& w, const MeshOutputArgs& a, Context* ctx, ContourMesh& mesh,
+                                    nlohmann::json& report) {
+  const double max_error = a.max_error_cells * w.lattice().cell_size;
+  Result<SimplifyUntangleStats> done =
+      simplify_and_untangle(mesh, {.max_error = max_error, .target_triangles = a.target_triangles},
+                            {.max_move = w.lattice().cell_size}, ctx);
+  if (!done.ok()) return done.status();
+  const SimplifyUntangleStats& s = done.value();
+  report["seconds"]["simplify"] = s.simplify_seconds;
+  report["seconds"]["untangle"] = s.untangle_seconds;
+  report["simplify"] = simplify_json(s.simplify, max_error, a.max_error_cells);
+  report["untangle"] = untangle_json(s.untangle);
+  if (s.retried)
+    report["untangle_retry"] = {{"uniform_pairs_before", s.uniform_untangle.pairs_before},
+                                {"uniform_pairs_after", s.uniform_untangle.pairs_after},
+                                {"pairs_after", s.untangle.pairs_after},
+                                {"used", s.retry_used},
+                                {"simplified_pairs_after", s.first_pairs_after}};
   return {};
 }
 
@@ -134,7 +131,7 @@ Result<ContourMesh> mesh_world(const World& w, const MeshOutputArgs& a, Context*
   if (!mesh.ok()) return mesh;
   const bool untangle = a.method != "mc" && a.config.untangle;
   if (a.max_error_cells > 0.0 && untangle) {
-    if (Status s = simplify_and_untangle(w, a, ctx, mesh.value(), report); !s.ok()) return s;
+    if (Status s = simplify_and_untangle_output(w, a, ctx, mesh.value(), report); !s.ok()) return s;
   } else if (a.max_error_cells > 0.0) {
     if (Status s = simplify_output(w, a, ctx, mesh.value(), report); !s.ok()) return s;
   } else if (untangle) {
@@ -191,13 +188,7 @@ Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report, 
   Result<UntangleMeshStats> untangled = untangle_mesh(mesh, options, ctx);
   report["seconds"]["untangle"] = u.seconds();
   if (!untangled.ok()) return untangled.status();
-  const UntangleMeshStats& s = untangled.value();
-  report["untangle"] = {{"pairs_before", s.pairs_before},
-                        {"pairs_after", s.pairs_after},
-                        {"vertices_moved", s.vertices_moved},
-                        {"rounds", s.rounds},
-                        {"specks_removed", s.specks_removed},
-                        {"speck_triangles_removed", s.speck_triangles_removed}};
+  report["untangle"] = untangle_json(untangled.value());
   return {};
 }
 
