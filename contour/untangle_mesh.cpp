@@ -261,7 +261,8 @@ void remove_triangles(ContourMesh& mesh, const std::vector<uint8_t>& gone) {
 }
 
 // Removes the closed components of at most max_vertices vertices that hold
-// a triangle of `pairs`; the pairs left are those of other components.
+// a triangle of `pairs`; the pairs left are those of other components (by
+// the old triangle numbers: the caller reads only how many are left).
 void remove_specks(ContourMesh& mesh, const Table& tris, const Neighbourhood& nb, int max_vertices,
                    std::vector<detail::TrianglePair>& pairs, UntangleMeshStats& stats) {
   uint32_t count = 0;

@@ -183,9 +183,9 @@ void print_report(const nlohmann::json& j) {
 
 }  // namespace
 
-Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report, const UntangleMeshOptions& options) {
+Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report) {
   ScopedTimer u(nullptr, "");
-  Result<UntangleMeshStats> untangled = untangle_mesh(mesh, options, ctx);
+  Result<UntangleMeshStats> untangled = untangle_mesh(mesh, {}, ctx);
   report["seconds"]["untangle"] = u.seconds();
   if (!untangled.ok()) return untangled.status();
   report["untangle"] = untangle_json(untangled.value());

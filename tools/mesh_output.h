@@ -58,8 +58,7 @@ int contour_and_report(const std::string& command, const World& world, const Mes
                        const ExtraReportLines& extra_lines = {});
 
 // untangle_mesh on `mesh`, reported as contour_and_report does.
-Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report,
-                      const UntangleMeshOptions& options = {});
+Status untangle_output(Context* ctx, ContourMesh& mesh, nlohmann::json& report);
 
 // Writes a mesh already made and prints the report, as contour_and_report.
 int write_and_report(const std::string& command, const World& world, const ContourMesh& mesh,
