@@ -455,9 +455,8 @@ Result<SimplifyStats> simplify_mesh(ContourMesh& mesh, const SimplifyOptions& op
 // left 4 pairs after any number of rounds). What the rounds leave in a
 // closed component of at most max_speck_vertices vertices is therefore
 // removed, speck and all: the only change of topology untangle_mesh makes,
-// counted in specks_removed. Its triangles go (the others keep their order),
-// and so do its vertices (the others keep their order; normals and vertex
-// materials follow).
+// counted in specks_removed. Its triangles go, and then every vertex no
+// triangle uses (the rest keep their order; normals and materials follow).
 struct UntangleMeshOptions {
   // Rounds before giving up [Limit: 0..1000]; 0 only counts the pairs.
   int max_rounds = 50;

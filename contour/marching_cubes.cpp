@@ -48,7 +48,7 @@ class CubeMesher {
       : w_(w), r_(r), cell_lo_(cell_lo), part_(out), out_(out.mesh), ids_(out.ids) {}
 
   void cube(const glm::ivec3& cell) {
-    const unsigned inside = inside_corners(cell);
+    const unsigned inside = r_.cell_corners(cell);
     const detail::CellSheets& sheets = detail::cell_sheets(inside, joined_faces(cell, inside));
     for (int s = 0; s < sheets.count; ++s) {
       uint32_t loop[12];
@@ -62,28 +62,14 @@ class CubeMesher {
   }
 
  private:
-  unsigned inside_corners(const glm::ivec3& cell) const {
-    unsigned inside = 0;
-    for (int c = 0; c < 8; ++c) inside |= unsigned(r_.inside(cell + corner(c))) << c;
-    return inside;
-  }
-
-  // The faces whose cubes on both sides would link both of the face's
-  // segments, joined from both sides as dual contouring joins them
-  // (detail::face_links_both_segments). Otherwise both cubes' loops pass
-  // through both segments, and their fans can both use the chord between
-  // the same two crossings: an edge of four triangles. The region holds one
-  // node more on every side than the cubes read, for the cubes across.
+  // The faces both cubes would link through both segments, joined from both
+  // sides as dual contouring joins them (detail::joined_faces). Otherwise both
+  // cubes' loops pass through both segments, and their fans can both use the
+  // chord between the same two crossings: an edge of four triangles. The
+  // region holds one node more on every side than the cubes read, for the
+  // cubes across.
   unsigned joined_faces(const glm::ivec3& cell, unsigned inside) const {
-    unsigned joined = 0;
-    for (int face = 0; face < 6; ++face) {
-      if (!detail::face_links_both_segments(inside, face)) continue;  // false on faces that are not ambiguous
-      const int axis = face / 2, side = face % 2;
-      glm::ivec3 across = cell;
-      across[axis] += side ? 1 : -1;
-      if (detail::face_links_both_segments(inside_corners(across), 2 * axis + 1 - side)) joined |= 1u << face;
-    }
-    return joined;
+    return detail::joined_faces(cell, inside, [&](const glm::ivec3& c) { return int(r_.cell_corners(c)); });
   }
 
   uint32_t vertex(const glm::ivec3& cell, int slot) {

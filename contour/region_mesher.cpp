@@ -41,26 +41,11 @@ const RegionMesher::CellVertex* RegionMesher::vertex(const glm::ivec3& cell, int
   return i < 0 ? nullptr : &verts_[size_t(i)];
 }
 
-unsigned RegionMesher::inside_corners(const glm::ivec3& cell) const {
-  unsigned bits = 0;
-  for (int c = 0; c < 8; ++c) bits |= unsigned(region_.inside(cell + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2))) << c;
-  return bits;
-}
-
-// The faces of the cell to join (see face_links_both_segments): those whose
-// cells on both sides would link both of the face's segments. Faces towards
-// cells outside the cell box stay apart; no vertex that matters is there.
+// The faces of the cell to join (detail::joined_faces). Faces towards cells
+// outside the cell box stay apart; no vertex that matters is there.
 unsigned RegionMesher::joined_faces(const glm::ivec3& cell, unsigned corners) const {
-  unsigned joined = 0;
-  for (int face = 0; face < 6; ++face) {
-    if (!face_links_both_segments(corners, face)) continue;  // false on faces that are not ambiguous
-    const int axis = face / 2, side = face % 2;
-    glm::ivec3 across = cell;
-    across[axis] += side ? 1 : -1;
-    if (!in_cell_box(across)) continue;
-    if (face_links_both_segments(inside_corners(across), 2 * axis + 1 - side)) joined |= 1u << face;
-  }
-  return joined;
+  return detail::joined_faces(cell, corners,
+                              [&](const glm::ivec3& c) { return in_cell_box(c) ? int(region_.cell_corners(c)) : -1; });
 }
 
 const CellSheets& RegionMesher::sheets_of(const glm::ivec3& cell) const {
@@ -183,7 +168,7 @@ void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& u
         const glm::ivec3 cell(x, y, z);
         const bool used = in_box(cell, used_lo, used_hi);
         if (!used && !has_mixed_crossings(cell)) continue;  // no sheet of it can be on a border
-        const unsigned corners = inside_corners(cell);
+        const unsigned corners = region_.cell_corners(cell);
         const unsigned joined = joined_faces(cell, corners);
         const CellSheets& sheets = cell_sheets(corners, joined);
         bool any_border = false;

@@ -52,6 +52,7 @@
 #include <tbb/parallel_for.h>
 
 #include "contour/contour.h"
+#include "contour/detail/remove_triangles.h"
 #include "contour/detail/triangle_intersection.h"
 
 namespace ldc {
@@ -1358,28 +1359,10 @@ void run_pass(Shared& s, PassInput& pass, SimplifyStats& stats) {
 
 // Writes the survivors back, in their order; unused vertices are dropped.
 void compact(const Shared& s, ContourMesh& mesh) {
-  std::vector<uint32_t> remap(mesh.vertex_count(), std::numeric_limits<uint32_t>::max());
-  ContourMesh out;
-  for (size_t t = 0; t < s.tris.size(); ++t) {
-    if (s.tstate[t] == kDead) continue;
-    glm::uvec3 tri = s.tris[t];
-    for (int k = 0; k < 3; ++k) {
-      uint32_t& index = remap[tri[k]];
-      if (index == std::numeric_limits<uint32_t>::max()) index = 0;  // used; numbered below
-    }
-    out.triangles.push_back(tri);
-    if (!mesh.triangle_material.empty()) out.triangle_material.push_back(mesh.triangle_material[t]);
-  }
-  uint32_t next = 0;
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    if (remap[v] == std::numeric_limits<uint32_t>::max()) continue;
-    remap[v] = next++;
-    out.positions.push_back(mesh.positions[v]);
-    if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[v]);
-    if (!mesh.vertex_material.empty()) out.vertex_material.push_back(mesh.vertex_material[v]);
-  }
-  for (glm::uvec3& tri : out.triangles) tri = glm::uvec3(remap[tri.x], remap[tri.y], remap[tri.z]);
-  mesh = std::move(out);
+  std::vector<uint8_t> dead(s.tris.size());
+  for (size_t t = 0; t < s.tris.size(); ++t) dead[t] = s.tstate[t] == kDead;
+  mesh.triangles = s.tris;
+  detail::remove_triangles(mesh, dead);
 }
 
 }  // namespace

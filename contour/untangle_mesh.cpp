@@ -35,6 +35,7 @@
 
 #include "contour/contour.h"
 #include "contour/detail/incidence.h"
+#include "contour/detail/remove_triangles.h"
 #include "contour/detail/self_intersections.h"
 #include "contour/detail/triangle_intersection.h"
 
@@ -230,36 +231,6 @@ std::vector<uint32_t> triangle_components(const ContourMesh& mesh, const Table& 
   return component;
 }
 
-// Removes the triangles whose `gone` is set, then the vertices no triangle
-// uses any more (were used before), keeping the order of the rest.
-void remove_triangles(ContourMesh& mesh, const std::vector<uint8_t>& gone) {
-  std::vector<uint8_t> used_before(mesh.vertex_count(), 0), used_after(mesh.vertex_count(), 0);
-  size_t kept = 0;
-  for (size_t t = 0; t < mesh.triangle_count(); ++t) {
-    for (int k = 0; k < 3; ++k) (gone[t] ? used_before : used_after)[mesh.triangles[t][k]] = 1;
-    if (gone[t]) continue;
-    mesh.triangles[kept] = mesh.triangles[t];
-    if (!mesh.triangle_material.empty()) mesh.triangle_material[kept] = mesh.triangle_material[t];
-    ++kept;
-  }
-  mesh.triangles.resize(kept);
-  if (!mesh.triangle_material.empty()) mesh.triangle_material.resize(kept);
-  std::vector<uint32_t> remap(mesh.vertex_count());
-  uint32_t next = 0;
-  for (size_t v = 0; v < mesh.vertex_count(); ++v) {
-    remap[v] = next;
-    if (used_before[v] && !used_after[v]) continue;  // only the removed triangles used it
-    mesh.positions[next] = mesh.positions[v];
-    if (mesh.normals.size() == mesh.vertex_count()) mesh.normals[next] = mesh.normals[v];
-    if (mesh.vertex_material.size() == mesh.vertex_count()) mesh.vertex_material[next] = mesh.vertex_material[v];
-    ++next;
-  }
-  if (mesh.normals.size() == mesh.positions.size()) mesh.normals.resize(next);
-  if (mesh.vertex_material.size() == mesh.positions.size()) mesh.vertex_material.resize(next);
-  mesh.positions.resize(next);
-  for (glm::uvec3& t : mesh.triangles) t = glm::uvec3(remap[t.x], remap[t.y], remap[t.z]);
-}
-
 // Removes the closed components of at most max_vertices vertices that hold
 // a triangle of `pairs`; the pairs left are those of other components (by
 // the old triangle numbers: the caller reads only how many are left).
@@ -285,7 +256,7 @@ void remove_specks(ContourMesh& mesh, const Table& tris, const Neighbourhood& nb
   if (stats.specks_removed == 0) return;
   for (uint8_t g : gone) stats.speck_triangles_removed += g;
   std::erase_if(pairs, [&](const detail::TrianglePair& p) { return gone[p.first] || gone[p.second]; });
-  remove_triangles(mesh, gone);
+  detail::remove_triangles(mesh, gone);
 }
 
 }  // namespace

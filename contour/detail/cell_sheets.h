@@ -52,6 +52,26 @@ bool face_is_ambiguous(unsigned inside_corners, int face);
 // tunnel into two sheets on one side or the other.
 bool face_links_both_segments(unsigned inside_corners, int face);
 
+// The faces of `cell` (inside corners `corners`) to join: those whose cells
+// on both sides would link both of the face's segments. corners_of(c)
+// gives the inside corners of a neighbouring cell c, or -1 when it is not
+// known (that face stays apart). The meshers' one rule, so that dual
+// contouring and marching cubes split and join the same faces.
+template <class CornersOf>
+unsigned joined_faces(const glm::ivec3& cell, unsigned corners, CornersOf&& corners_of) {
+  unsigned joined = 0;
+  for (int face = 0; face < 6; ++face) {
+    if (!face_links_both_segments(corners, face)) continue;  // false on faces that are not ambiguous
+    const int axis = face / 2, side = face % 2;
+    glm::ivec3 across = cell;
+    across[axis] += side ? 1 : -1;
+    const int across_corners = corners_of(across);
+    if (across_corners >= 0 && face_links_both_segments(unsigned(across_corners), 2 * axis + 1 - side))
+      joined |= 1u << face;
+  }
+  return joined;
+}
+
 // The lower corner's offset in the cell, and the axis, of edge slot `slot`.
 glm::ivec3 cell_edge_offset(int slot);
 inline int cell_edge_axis(int slot) { return slot / 4; }

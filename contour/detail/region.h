@@ -36,6 +36,13 @@ class Region {
     return (size_t(r.z) * size_.y + size_t(r.y)) * size_.x + size_t(r.x);
   }
   bool inside(const glm::ivec3& node) const { return signs_[index(node)] != 0; }
+  // Bit c set when corner c (bits x, y, z) of the cell whose lowest node is
+  // `cell` is inside: the index of detail::cell_sheets. Its 8 nodes must be in the region.
+  unsigned cell_corners(const glm::ivec3& cell) const {
+    unsigned bits = 0;
+    for (int c = 0; c < 8; ++c) bits |= unsigned(inside(cell + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2))) << c;
+    return bits;
+  }
   size_t stride(int axis) const {
     return axis == 0 ? 1 : axis == 1 ? size_t(size_.x) : size_t(size_.x) * size_t(size_.y);
   }

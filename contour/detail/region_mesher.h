@@ -59,7 +59,6 @@ class RegionMesher {
   void load(const glm::ivec3& own_lo, const glm::ivec3& own_hi, int low, int high);
   bool single_material() const;
   void mark_cells_with_vertex();
-  unsigned inside_corners(const glm::ivec3& cell) const;
   unsigned joined_faces(const glm::ivec3& cell, unsigned corners) const;
   const CellSheets& sheets_of(const glm::ivec3& cell) const;
   // The sheet of `cell` that holds the edge from `node` along `axis` (a crossing edge of the cell).
