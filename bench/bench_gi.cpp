@@ -12,7 +12,9 @@
 // Usage: bench_gi [points (200)] [paths per point (512)] [sources: only the
 // error split by light source | timing: only medians of full updates |
 // images [DIR]: only whole images against the path tracer (gi_images.cpp),
-// paths per pixel, PNGs into DIR]
+// paths per pixel, PNGs into DIR | visibility: only the cones' sky against
+// exact rays in the same views (gi_images.cpp), the second number the rays
+// per cone]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -362,6 +364,10 @@ int main(int argc, char** argv) {
   }
   if (argc > 3 && std::string(argv[3]) == "images") {
     ldc::bench::gi_images(paths, argc > 4 ? argv[4] : nullptr, true);
+    return 0;
+  }
+  if (argc > 3 && std::string(argv[3]) == "visibility") {
+    ldc::bench::gi_sky_visibility(paths);
     return 0;
   }
   if (argc > 3 && std::string(argv[3]) == "sources") {

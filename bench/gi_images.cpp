@@ -19,6 +19,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -189,16 +191,18 @@ void run_view(const View& v, int paths, const char* dir, bool with_vulkan) {
   }
 }
 
-}  // namespace
+// The worlds the views look at (built once) and the views.
+struct Scenes {
+  World tunnel, room;
+  std::vector<View> views;
+};
 
-void gi_images(int paths, const char* dir, bool with_vulkan) {
+Result<std::unique_ptr<Scenes>> issue25_scenes() {
   Result<World> dug = main_job_tunnel();
-  if (!dug.ok()) {
-    std::printf("main job's tunnel failed: %s\n", dug.status().message().c_str());
-    return;
-  }
-  const World& tunnel = dug.value();
-  const World room = closed_room();
+  if (!dug.ok()) return Status(dug.status().code(), "main job's tunnel: " + dug.status().message());
+  auto sc = std::make_unique<Scenes>(Scenes{std::move(dug).value(), closed_room(), {}});
+  const World* tunnel = &sc->tunnel;
+  const World* room = &sc->room;
   GiLights sky;
   sky.sky = default_sky();
   GiLights chamber_light = sky;
@@ -208,16 +212,161 @@ void gi_images(int paths, const char* dir, bool with_vulkan) {
   GiLights room_light;
   room_light.points.push_back({glm::dvec3(0.8, -0.6, 0.9), glm::vec3(3.0f)});
   const MaterialTable terrain = default_material_table();
-  const View views[] = {
-      {"landscape", &tunnel, {61, -5, 10}, {45, 11, 3.4}, 55, sky, terrain},
-      {"tunnel_near_mouth", &tunnel, {44, 10.4, 3.4}, {37, 11, 3.4}, 70, sky, terrain},
-      {"tunnel_far_from_mouths", &tunnel, {8, 9.8, 3.6}, {14, 10, 3.6}, 70, sky, terrain},
-      {"chamber_sky_and_light", &tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, chamber_light, terrain},
-      {"chamber_light_only", &tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, light_only, terrain},
-      {"chamber_sky_only", &tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, sky, terrain},
-      {"closed_room_light", &room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, room_light, room_materials(0.0f)},
-      {"closed_room_sky_outside", &room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, sky, room_materials(0.0f)},
-      {"furnace", &room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, GiLights{}, room_materials(1.0f)}};
+  sc->views = {
+      {"landscape", tunnel, {61, -5, 10}, {45, 11, 3.4}, 55, sky, terrain},
+      {"tunnel_near_mouth", tunnel, {44, 10.4, 3.4}, {37, 11, 3.4}, 70, sky, terrain},
+      {"tunnel_far_from_mouths", tunnel, {8, 9.8, 3.6}, {14, 10, 3.6}, 70, sky, terrain},
+      {"chamber_sky_and_light", tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, chamber_light, terrain},
+      {"chamber_light_only", tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, light_only, terrain},
+      {"chamber_sky_only", tunnel, {20, 9.2, 4.0}, {26, 9, 3.6}, 70, sky, terrain},
+      {"closed_room_light", room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, room_light, room_materials(0.0f)},
+      {"closed_room_sky_outside", room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, sky, room_materials(0.0f)},
+      {"furnace", room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, GiLights{}, room_materials(1.0f)}};
+  return sc;
+}
+
+Result<Camera> view_camera(const View& v) {
+  CameraConfig cc;
+  cc.position = v.camera;
+  cc.target = v.target;
+  cc.fov_degrees = v.fov;
+  cc.width = kWidth;
+  cc.height = kHeight;
+  return Camera::make(cc, v.world);
+}
+
+// --- Sky visibility per cone: the cone tracer's against exact rays ------------------
+
+struct SurfacePoint {
+  glm::dvec3 p;
+  glm::vec3 n;
+};
+
+// Every `stride`-th pixel's first hit on the view's solid.
+std::vector<SurfacePoint> sample_pixels(const View& v, const Camera& cam, int stride) {
+  Queries q(*v.world);
+  std::vector<SurfacePoint> out;
+  for (int y = stride / 2; y < kHeight; y += stride)
+    for (int x = stride / 2; x < kWidth; x += stride) {
+      Result<RayHit> h = q.ray_cast(cam.pixel_ray(x, y));
+      if (h.ok() && h.value().hit && !h.value().started_inside) out.push_back({h.value().point, h.value().normal});
+    }
+  return out;
+}
+
+// The part of cone i's rays (directions within its half-angle, cos >= 7/8,
+// spread evenly: rings in cos, golden-angle turns) from the point that
+// leave the world without meeting the solid.
+double exact_escape(const Queries& q, const SurfacePoint& sp, const glm::vec3& axis, int rays) {
+  const glm::dvec3 d(axis);
+  const glm::dvec3 a = std::abs(d.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 u = glm::normalize(glm::cross(d, a)), w = glm::cross(d, u);
+  int escaped = 0;
+  for (int k = 0; k < rays; ++k) {
+    const double ct = 1.0 - (k + 0.5) / rays * (1.0 - 0.875), st = std::sqrt(1.0 - ct * ct);
+    const double phi = 2.399963229728653 * k;
+    const glm::dvec3 dir = d * ct + u * (st * std::cos(phi)) + w * (st * std::sin(phi));
+    Result<RayHit> h = q.ray_cast(Ray{sp.p + 1e-3 * glm::dvec3(sp.n), dir});
+    if (h.ok() && !h.value().hit) ++escaped;
+  }
+  return double(escaped) / rays;
+}
+
+// The cone tracer's sky transmittance of each point's cone i (0 where the
+// point's air is sealed): irradiance under a sky of 1 in lobe i alone, the
+// materials black, times sum_j c_j / (pi c_i).
+Result<std::vector<double>> cone_sky(const View& v, const Camera& cam, GiEngine& gi,
+                                     const std::vector<SurfacePoint>& pts, int i) {
+  MaterialTable black = v.materials;
+  for (VoxelMaterial& m : black.materials) m = VoxelMaterial{glm::vec3(0.0f), glm::vec3(0.0f)};
+  black.fallback = VoxelMaterial{glm::vec3(0.0f), glm::vec3(0.0f)};
+  CascadeConfig cc;
+  cc.voxel_size = 2.0 * v.world->lattice().cell_size;
+  cc.materials = black;
+  Result<Cascades> cas = Cascades::create(v.world->lattice(), cc);
+  if (!cas.ok()) return cas.status();
+  if (Status s = cas.value().update_all(*v.world, cam.position()); !s.ok()) return s;
+  GiLights lobe;
+  lobe.sky.amplitude[size_t(i)] = glm::vec3(1.0f);
+  if (Status s = gi.load(cas.value(), lobe); !s.ok()) return s;
+  std::vector<glm::dvec3> p(pts.size());
+  std::vector<glm::vec3> n(pts.size()), e(pts.size());
+  for (size_t k = 0; k < pts.size(); ++k) p[k] = pts[k].p, n[k] = pts[k].n;
+  if (Status s = gi.irradiance(p, n, 1, e); !s.ok()) return s;
+  std::vector<double> t(pts.size(), 0.0);
+  const glm::vec3 axis = gi_directions()[size_t(i)];
+  for (size_t k = 0; k < pts.size(); ++k) {
+    double sum = 0.0;
+    for (const glm::vec3& dj : gi_directions()) sum += std::max(0.0f, glm::dot(n[k], dj));
+    const double c = glm::dot(n[k], axis);
+    if (c > 0.0) t[k] = double(e[k].y) * sum / (std::numbers::pi * c);
+  }
+  return t;
+}
+
+void visibility_row(const View& v, int rays) {
+  Result<Camera> cam = view_camera(v);
+  if (!cam.ok()) return;
+  const std::vector<SurfacePoint> pts = sample_pixels(v, cam.value(), 4);
+  Queries q(*v.world);
+  std::unique_ptr<GiEngine> gi = make_cpu_gi();
+  double cone = 0, exact = 0, over = 0, leak = 0, weight = 0;
+  for (int i = 0; i < kGiDirections; ++i) {
+    Result<std::vector<double>> t = cone_sky(v, cam.value(), *gi, pts, i);
+    if (!t.ok()) {
+      std::printf("| %s | failed: %s |\n", v.name.c_str(), t.status().message().c_str());
+      return;
+    }
+    const glm::vec3 axis = gi_directions()[size_t(i)];
+    for (size_t k = 0; k < pts.size(); ++k) {
+      const double c = glm::dot(pts[k].n, axis);
+      if (c <= 0.0) continue;
+      const double e = exact_escape(q, pts[k], axis, rays), tc = t.value()[k];
+      cone += c * tc, exact += c * e, weight += c;
+      over += c * std::max(e - tc, 0.0), leak += c * std::max(tc - e, 0.0);
+    }
+  }
+  if (exact <= 0.0) {
+    std::printf("| %s | %zu | %.4f | 0 | — | — | %.4f |\n", v.name.c_str(), pts.size(), cone / weight, leak / weight);
+    return;
+  }
+  std::printf("| %s | %zu | %.4f | %.4f | %.3f | %.3f | %.3f |\n", v.name.c_str(), pts.size(), cone / weight,
+              exact / weight, cone / exact, over / exact, leak / exact);
+}
+
+}  // namespace
+
+void gi_sky_visibility(int rays) {
+  Result<std::unique_ptr<Scenes>> sc = issue25_scenes();
+  if (!sc.ok()) {
+    std::printf("scenes failed: %s\n", sc.status().message().c_str());
+    return;
+  }
+  std::printf("\n## Sky visibility per cone: the cone tracer against exact rays (issue 25)\n");
+  std::printf("Every 4th pixel's first hit in x and y; per point and cone i with c = n . d_i > 0: the cone tracer's sky "
+              "transmittance (CPU engine, 6 levels of 32^3 voxels of 2 h centred on the camera) against the part of "
+              "%d rays spread over the cone that leave the world (ldc ray casts), weighted by c. Too dark = sum c "
+              "max(exact - cone, 0) / sum c exact; leaked = sum c max(cone - exact, 0) / sum c exact (by the cone "
+              "weight's sum where no ray escapes).\n",
+              rays);
+  std::printf("| view | points | cone sky | exact sky | cone / exact | too dark | leaked |\n|---|---|---|---|---|---|---|\n");
+  const char* only = std::getenv("BENCH_GI_VIEW");
+  std::string done;
+  for (const View& v : sc.value()->views) {
+    // One row per camera: the lights do not change what the sky reaches.
+    const std::string key = std::to_string(v.camera.x) + std::to_string(v.camera.y) + std::to_string(v.camera.z);
+    if (done.find("|" + key + "|") != std::string::npos) continue;
+    done += "|" + key + "|";
+    if (!only || v.name.find(only) != std::string::npos) visibility_row(v, rays);
+  }
+}
+
+void gi_images(int paths, const char* dir, bool with_vulkan) {
+  Result<std::unique_ptr<Scenes>> sc = issue25_scenes();
+  if (!sc.ok()) {
+    std::printf("%s\n", sc.status().message().c_str());
+    return;
+  }
   std::printf("\n## Whole images against the path tracer (issue 25)\n");
   std::printf("%d x %d pixels, 3 bounces, cascades of 6 levels of 32^3 voxels of 2 h centred on the camera, 3 passes; "
               "reference: mean of 2 path-traced images of %d paths per pixel (seeds 1, 2)\n",
@@ -225,7 +374,7 @@ void gi_images(int paths, const char* dir, bool with_vulkan) {
   std::printf("| view | engine | rel. L1 | rel. L1, darkest fifth | brightness | reference noise (seed 2 vs 1) | paths |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   const char* only = std::getenv("BENCH_GI_VIEW");  // a substring of the views to run (all when unset)
-  for (const View& v : views)
+  for (const View& v : sc.value()->views)
     if (!only || v.name.find(only) != std::string::npos) run_view(v, paths, dir, with_vulkan);
 }
 

@@ -7,4 +7,8 @@ namespace ldc::bench {
 // writes each view's cone-traced | path-traced pair there as a PNG.
 void gi_images(int paths, const char* dir, bool with_vulkan);
 
+// Prints, per camera of those views, how much sky the cone tracer's cones
+// let through against the part of `rays` exact rays per cone that escape.
+void gi_sky_visibility(int rays);
+
 }  // namespace ldc::bench
