@@ -211,6 +211,8 @@ def main():
     p.add_argument("--runs", type=int, default=50)
     p.add_argument("--ldc", default=os.path.join(ROOT, "build", "tools", "ldc"))
     p.add_argument("--check", default=os.path.join(ROOT, "build", "tests", "cgal_check_mesh"))
+    p.add_argument("--meshes", default=None,
+                   help="comma-separated OBJ files to use instead of the built-in list (held-out inputs)")
     p.add_argument("--work", default=None, help="folder for outputs and kept failing inputs (default: a new temporary one)")
     args = p.parse_args()
     for tool in (args.ldc, args.check):
@@ -219,7 +221,7 @@ def main():
     args.work = args.work or tempfile.mkdtemp(prefix="ldc-sweep-")
     os.makedirs(args.work, exist_ok=True)
     sweep, rng = Sweep(args), random.Random(args.seed)
-    meshes = mesh_files()
+    meshes = args.meshes.split(",") if args.meshes else mesh_files()
     box_of = {m: bounds(m) for m in meshes} if args.kind == "boolean" else {}
     world = os.path.join(args.work, "landscape.ldc")
     if args.kind == "edit":
