@@ -150,14 +150,18 @@ Result<RadianceImage> cone_image(const View& v, const Camera& cam, GiEngine& gi)
   return render_gi(queries, cam, gi, {.materials = v.materials, .sky = v.lights.sky, .bounces = 3});
 }
 
-void run_view(const View& v, int paths, const char* dir, bool with_vulkan) {
+Result<Camera> view_camera(const View& v) {
   CameraConfig cc;
   cc.position = v.camera;
   cc.target = v.target;
   cc.fov_degrees = v.fov;
   cc.width = kWidth;
   cc.height = kHeight;
-  Result<Camera> cam = Camera::make(cc, v.world);
+  return Camera::make(cc, v.world);
+}
+
+void run_view(const View& v, int paths, const char* dir, bool with_vulkan) {
+  Result<Camera> cam = view_camera(v);
   if (!cam.ok()) return;
   std::vector<Ray> rays;
   for (int y = 0; y < kHeight; ++y)
@@ -223,16 +227,6 @@ Result<std::unique_ptr<Scenes>> issue25_scenes() {
       {"closed_room_sky_outside", room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, sky, room_materials(0.0f)},
       {"furnace", room, {-1.4, -1.6, 0.8}, {1.0, 1.2, -0.8}, 75, GiLights{}, room_materials(1.0f)}};
   return sc;
-}
-
-Result<Camera> view_camera(const View& v) {
-  CameraConfig cc;
-  cc.position = v.camera;
-  cc.target = v.target;
-  cc.fov_degrees = v.fov;
-  cc.width = kWidth;
-  cc.height = kHeight;
-  return Camera::make(cc, v.world);
 }
 
 // --- Sky visibility per cone: the cone tracer's against exact rays ------------------
@@ -334,12 +328,18 @@ void visibility_row(const View& v, int rays) {
               exact / weight, cone / exact, over / exact, leak / exact);
 }
 
+// BENCH_GI_VIEW: a substring of the views to run (all when unset).
+bool view_wanted(const View& v) {
+  const char* only = std::getenv("BENCH_GI_VIEW");
+  return !only || v.name.find(only) != std::string::npos;
+}
+
 }  // namespace
 
 void gi_sky_visibility(int rays) {
   Result<std::unique_ptr<Scenes>> sc = issue25_scenes();
   if (!sc.ok()) {
-    std::printf("scenes failed: %s\n", sc.status().message().c_str());
+    std::printf("%s\n", sc.status().message().c_str());
     return;
   }
   std::printf("\n## Sky visibility per cone: the cone tracer against exact rays (issue 25)\n");
@@ -350,14 +350,12 @@ void gi_sky_visibility(int rays) {
               "weight's sum where no ray escapes).\n",
               rays);
   std::printf("| view | points | cone sky | exact sky | cone / exact | too dark | leaked |\n|---|---|---|---|---|---|---|\n");
-  const char* only = std::getenv("BENCH_GI_VIEW");
-  std::string done;
+  // One row per camera: the lights do not change what the sky reaches.
+  std::vector<glm::dvec3> cameras;
   for (const View& v : sc.value()->views) {
-    // One row per camera: the lights do not change what the sky reaches.
-    const std::string key = std::to_string(v.camera.x) + std::to_string(v.camera.y) + std::to_string(v.camera.z);
-    if (done.find("|" + key + "|") != std::string::npos) continue;
-    done += "|" + key + "|";
-    if (!only || v.name.find(only) != std::string::npos) visibility_row(v, rays);
+    if (std::find(cameras.begin(), cameras.end(), v.camera) != cameras.end()) continue;
+    cameras.push_back(v.camera);
+    if (view_wanted(v)) visibility_row(v, rays);
   }
 }
 
@@ -373,9 +371,8 @@ void gi_images(int paths, const char* dir, bool with_vulkan) {
               kWidth, kHeight, paths);
   std::printf("| view | engine | rel. L1 | rel. L1, darkest fifth | brightness | reference noise (seed 2 vs 1) | paths |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
-  const char* only = std::getenv("BENCH_GI_VIEW");  // a substring of the views to run (all when unset)
   for (const View& v : sc.value()->views)
-    if (!only || v.name.find(only) != std::string::npos) run_view(v, paths, dir, with_vulkan);
+    if (view_wanted(v)) run_view(v, paths, dir, with_vulkan);
 }
 
 }  // namespace ldc::bench
