@@ -266,11 +266,9 @@ double exact_escape(const Queries& q, const SurfacePoint& sp, const glm::vec3& a
   return double(escaped) / rays;
 }
 
-// The cone tracer's sky transmittance of each point's cone i (0 where the
-// point's air is sealed): irradiance under a sky of 1 in lobe i alone, the
-// materials black, times sum_j c_j / (pi c_i).
-Result<std::vector<double>> cone_sky(const View& v, const Camera& cam, GiEngine& gi,
-                                     const std::vector<SurfacePoint>& pts, int i) {
+// The view's cascades with every material black, so that a query sees
+// nothing but the sky.
+Result<Cascades> black_cascades(const View& v, const Camera& cam) {
   MaterialTable black = v.materials;
   for (VoxelMaterial& m : black.materials) m = VoxelMaterial{glm::vec3(0.0f), glm::vec3(0.0f)};
   black.fallback = VoxelMaterial{glm::vec3(0.0f), glm::vec3(0.0f)};
@@ -280,9 +278,17 @@ Result<std::vector<double>> cone_sky(const View& v, const Camera& cam, GiEngine&
   Result<Cascades> cas = Cascades::create(v.world->lattice(), cc);
   if (!cas.ok()) return cas.status();
   if (Status s = cas.value().update_all(*v.world, cam.position()); !s.ok()) return s;
+  return cas;
+}
+
+// The cone tracer's sky transmittance of each point's cone i (0 where the
+// point's air is sealed): irradiance under a sky of 1 in lobe i alone, on
+// black cascades, times sum_j c_j / (pi c_i).
+Result<std::vector<double>> cone_sky(const Cascades& black, GiEngine& gi, const std::vector<SurfacePoint>& pts,
+                                     int i) {
   GiLights lobe;
   lobe.sky.amplitude[size_t(i)] = glm::vec3(1.0f);
-  if (Status s = gi.load(cas.value(), lobe); !s.ok()) return s;
+  if (Status s = gi.load(black, lobe); !s.ok()) return s;
   std::vector<glm::dvec3> p(pts.size());
   std::vector<glm::vec3> n(pts.size()), e(pts.size());
   for (size_t k = 0; k < pts.size(); ++k) p[k] = pts[k].p, n[k] = pts[k].n;
@@ -304,9 +310,14 @@ void visibility_row(const View& v, int rays) {
   const std::vector<SurfacePoint> pts = sample_pixels(v, cam.value(), 4);
   Queries q(*v.world);
   std::unique_ptr<GiEngine> gi = make_cpu_gi();
+  Result<Cascades> black = black_cascades(v, cam.value());
+  if (!black.ok()) {
+    std::printf("| %s | failed: %s |\n", v.name.c_str(), black.status().message().c_str());
+    return;
+  }
   double cone = 0, exact = 0, over = 0, leak = 0, weight = 0;
   for (int i = 0; i < kGiDirections; ++i) {
-    Result<std::vector<double>> t = cone_sky(v, cam.value(), *gi, pts, i);
+    Result<std::vector<double>> t = cone_sky(black.value(), *gi, pts, i);
     if (!t.ok()) {
       std::printf("| %s | failed: %s |\n", v.name.c_str(), t.status().message().c_str());
       return;

@@ -323,19 +323,21 @@ Result<UntangleMeshStats> untangle_mesh(ContourMesh& mesh, const UntangleMeshOpt
 
 namespace {
 
-// simplify_mesh then untangle_mesh on `mesh`, adding their times to `stats`.
+// simplify_mesh then untangle_mesh on `mesh`: their stats into `simple` and
+// `untangled`, their times added to `stats`.
 Status simplify_then_untangle(ContourMesh& mesh, const SimplifyOptions& simplify, const UntangleMeshOptions& untangle,
-                              Context* ctx, SimplifyUntangleStats& stats) {
+                              Context* ctx, SimplifyUntangleStats& stats, SimplifyStats& simple,
+                              UntangleMeshStats& untangled) {
   ScopedTimer s(nullptr, "");
-  Result<SimplifyStats> simple = simplify_mesh(mesh, simplify, ctx);
+  Result<SimplifyStats> simplified = simplify_mesh(mesh, simplify, ctx);
   stats.simplify_seconds += s.seconds();
-  if (!simple.ok()) return simple.status();
-  stats.simplify = simple.value();
+  if (!simplified.ok()) return simplified.status();
+  simple = simplified.value();
   ScopedTimer u(nullptr, "");
-  Result<UntangleMeshStats> untangled = untangle_mesh(mesh, untangle, ctx);
+  Result<UntangleMeshStats> done = untangle_mesh(mesh, untangle, ctx);
   stats.untangle_seconds += u.seconds();
-  if (!untangled.ok()) return untangled.status();
-  stats.untangle = untangled.value();
+  if (!done.ok()) return done.status();
+  untangled = done.value();
   return {};
 }
 
@@ -346,7 +348,8 @@ Result<SimplifyUntangleStats> simplify_and_untangle(ContourMesh& mesh, const Sim
   if (Status s = check_untangle_mesh_options(untangle); !s.ok()) return s;
   SimplifyUntangleStats stats;
   ContourMesh uniform = mesh;
-  if (Status s = simplify_then_untangle(mesh, simplify, untangle, ctx, stats); !s.ok()) return s;
+  if (Status s = simplify_then_untangle(mesh, simplify, untangle, ctx, stats, stats.simplify, stats.untangle); !s.ok())
+    return s;
   stats.first_pairs_after = stats.untangle.pairs_after;
   if (stats.first_pairs_after == 0) return stats;
   stats.retried = true;
@@ -357,13 +360,13 @@ Result<SimplifyUntangleStats> simplify_and_untangle(ContourMesh& mesh, const Sim
   stats.untangle_seconds += u.seconds();
   if (!first.ok()) return first.status();
   stats.uniform_untangle = first.value();
-  SimplifyUntangleStats second = stats;
-  if (Status s = simplify_then_untangle(uniform, simplify, untangle, ctx, second); !s.ok()) return s;
-  stats.simplify_seconds = second.simplify_seconds, stats.untangle_seconds = second.untangle_seconds;
-  if (second.untangle.pairs_after >= stats.first_pairs_after) return stats;
+  SimplifyStats simple;
+  UntangleMeshStats untangled;
+  if (Status s = simplify_then_untangle(uniform, simplify, untangle, ctx, stats, simple, untangled); !s.ok()) return s;
+  if (untangled.pairs_after >= stats.first_pairs_after) return stats;
   stats.retry_used = true;
-  stats.simplify = second.simplify;
-  stats.untangle = second.untangle;
+  stats.simplify = simple;
+  stats.untangle = untangled;
   mesh = std::move(uniform);
   return stats;
 }

@@ -75,16 +75,20 @@ nlohmann::json simplify_json(const SimplifyStats& s, double max_error, double ce
           {"max_error_reached", s.max_error_reached}};
 }
 
-// Simplifies within --max-error (cells), timed.
+// --max-error (cells of h) and --target-triangles as simplify_mesh takes them.
+SimplifyOptions simplify_options(const World& w, const MeshOutputArgs& a) {
+  return {.max_error = a.max_error_cells * w.lattice().cell_size, .target_triangles = a.target_triangles};
+}
+
+// Simplifies within --max-error, timed.
 Status simplify_output(const World& w, const MeshOutputArgs& a, Context* ctx, ContourMesh& mesh,
                        nlohmann::json& report) {
-  const double max_error = a.max_error_cells * w.lattice().cell_size;
+  const SimplifyOptions options = simplify_options(w, a);
   ScopedTimer s(nullptr, "");
-  Result<SimplifyStats> simple =
-      simplify_mesh(mesh, {.max_error = max_error, .target_triangles = a.target_triangles}, ctx);
+  Result<SimplifyStats> simple = simplify_mesh(mesh, options, ctx);
   report["seconds"]["simplify"] = s.seconds();
   if (!simple.ok()) return simple.status();
-  report["simplify"] = simplify_json(simple.value(), max_error, a.max_error_cells);
+  report["simplify"] = simplify_json(simple.value(), options.max_error, a.max_error_cells);
   return {};
 }
 
@@ -102,15 +106,13 @@ nlohmann::json untangle_json(const UntangleMeshStats& s) {
 // the first way left pairs.
 Status simplify_and_untangle_output(const World& w, const MeshOutputArgs& a, Context* ctx, ContourMesh& mesh,
                                     nlohmann::json& report) {
-  const double max_error = a.max_error_cells * w.lattice().cell_size;
-  Result<SimplifyUntangleStats> done =
-      simplify_and_untangle(mesh, {.max_error = max_error, .target_triangles = a.target_triangles},
-                            {.max_move = w.lattice().cell_size}, ctx);
+  const SimplifyOptions options = simplify_options(w, a);
+  Result<SimplifyUntangleStats> done = simplify_and_untangle(mesh, options, {.max_move = w.lattice().cell_size}, ctx);
   if (!done.ok()) return done.status();
   const SimplifyUntangleStats& s = done.value();
   report["seconds"]["simplify"] = s.simplify_seconds;
   report["seconds"]["untangle"] = s.untangle_seconds;
-  report["simplify"] = simplify_json(s.simplify, max_error, a.max_error_cells);
+  report["simplify"] = simplify_json(s.simplify, options.max_error, a.max_error_cells);
   report["untangle"] = untangle_json(s.untangle);
   if (s.retried)
     report["untangle_retry"] = {{"uniform_pairs_before", s.uniform_untangle.pairs_before},
