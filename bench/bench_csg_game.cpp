@@ -3,9 +3,10 @@
 // chunks they dirtied (ChunkedMesh::update), at 1 and 2 threads and chunk sizes
 // 16 and 32; then 1,000 random digs with time per edit and memory.
 //
-// Usage: bench_csg_game [--quick | --dig [runs]]
+// Usage: bench_csg_game [--quick | --dig [runs] [untangle]]
 //   --dig: only the 2 m sphere dig + re-mesh (C = 32, LiveConfig's contour
-//   config), median and p95 over `runs` (default 101) at 1 and 2 threads.
+//   config, or with ContourConfig::untangle on when `untangle` follows), median
+//   and p95 over `runs` (default 101) at 1 and 2 threads.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -147,14 +148,15 @@ void stress_table(bool quick) {
 }
 
 // The budget row alone, with its spread: median and p95 of edit + re-mesh.
-void dig_table(int runs) {
-  std::printf("\n## 2 m sphere dig + re-mesh (h = 0.2 m, C = 32, untangle off), %d runs\n\n", runs);
+void dig_table(int runs, bool untangle) {
+  std::printf("\n## 2 m sphere dig + re-mesh (h = 0.2 m, C = 32, untangle %s), %d runs\n\n", untangle ? "on" : "off",
+              runs);
   std::printf("| threads | edit ms median | edit + re-mesh ms median | p95 | min |\n|---|---|---|---|---|\n");
   ldc::World w = ldc::build_terrain({}, 0.2, 32).value();
   for (int threads : {1, 2}) {
     tbb::global_control gc(tbb::global_control::max_allowed_parallelism, size_t(threads));
     ldc::WorldEditor ed(w);
-    ldc::ChunkedMesh meshes({.untangle = false});
+    ldc::ChunkedMesh meshes({.untangle = untangle});
     if (!meshes.build(ed.world()).ok()) std::abort();
     const GameEdit dig = game_edits(w).front();
     std::vector<double> edit, total;
@@ -180,7 +182,8 @@ void dig_table(int runs) {
 
 int main(int argc, char** argv) {
   if (argc > 1 && std::strcmp(argv[1], "--dig") == 0) {
-    dig_table(argc > 2 ? std::max(1, std::atoi(argv[2])) : 101);
+    const bool untangle = argc > 3 && std::strcmp(argv[3], "untangle") == 0;
+    dig_table(argc > 2 ? std::max(1, std::atoi(argv[2])) : 101, untangle);
     return 0;
   }
   bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
