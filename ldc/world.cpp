@@ -42,21 +42,39 @@ bool RayFamily::starts_inside(int ray) const {
   return (inside_[static_cast<size_t>(ray) >> 6] >> (ray & 63)) & 1u;
 }
 
+// Sum of the byte lanes of x (each at most 255 / 8 in use here).
+static uint32_t byte_sum(uint64_t x) {
+  x = (x & 0x00FF00FF00FF00FFull) + ((x >> 8) & 0x00FF00FF00FF00FFull);
+  x = (x & 0x0000FFFF0000FFFFull) + ((x >> 16) & 0x0000FFFF0000FFFFull);
+  return uint32_t(x & 0xFFFFFFFFu) + uint32_t(x >> 32);
+}
+
 uint32_t RayFamily::first_point(int ray) const {
   if (is_uniform()) return 0;
   if (!first_.empty()) return first_[size_t(ray)];
   const int row = ray / size_;
   // Sum the counts before the ray in its row, eight bytes at a time.
-  const uint8_t* p = counts_.data() + size_t(row) * size_;
   const int n = ray - row * size_;
   uint32_t begin = row_first_[size_t(row)];
+  if (nibble_counts_) {
+    const uint8_t* p = counts_.data() + size_t(row) * size_ / 2;  // C is even: rows start on a byte
+    const int bytes = n / 2;
+    int i = 0;
+    for (; i + 8 <= bytes; i += 8) {
+      uint64_t w;
+      std::memcpy(&w, p + i, 8);
+      begin += byte_sum((w & 0x0F0F0F0F0F0F0F0Full) + ((w >> 4) & 0x0F0F0F0F0F0F0F0Full));
+    }
+    for (; i < bytes; ++i) begin += (p[i] & 15u) + (p[i] >> 4);
+    if (n & 1) begin += p[bytes] & 15u;
+    return begin;
+  }
+  const uint8_t* p = counts_.data() + size_t(row) * size_;
   int i = 0;
   for (; i + 8 <= n; i += 8) {
     uint64_t w;
     std::memcpy(&w, p + i, 8);
-    w = (w & 0x00FF00FF00FF00FFull) + ((w >> 8) & 0x00FF00FF00FF00FFull);
-    w = (w & 0x0000FFFF0000FFFFull) + ((w >> 16) & 0x0000FFFF0000FFFFull);
-    begin += uint32_t(w & 0xFFFFFFFFu) + uint32_t(w >> 32);
+    begin += byte_sum(w);
   }
   for (; i < n; ++i) begin += p[i];
   return begin;
@@ -85,10 +103,12 @@ std::string RayFamily::check_structure() const {
     }
     return {};
   }
-  if (counts_.size() != rays || row_first_.size() != c + 1) return "count arrays have the wrong size";
+  if (counts_.size() != (nibble_counts_ ? rays / 2 : rays) || row_first_.size() != c + 1) {
+    return "count arrays have the wrong size";
+  }
   for (size_t row = 0; row < c; ++row) {
     uint32_t end = row_first_[row];
-    for (size_t r = row * c; r < (row + 1) * c; ++r) end += counts_[r];
+    for (size_t r = row * c; r < (row + 1) * c; ++r) end += point_count(int(r));
     if (row_first_[row + 1] != end) return "row offsets disagree with counts at row " + std::to_string(row);
   }
   if (row_first_[0] != 0 || row_first_[c] != points_.size()) return "row offsets do not cover the point array";
@@ -120,11 +140,17 @@ RayFamily RayFamilyWriter::finish() {
   RayFamily f;
   f.size_ = static_cast<uint8_t>(c);
   first_.push_back(static_cast<uint32_t>(points_.size()));
-  bool compact = true;
-  for (int r = 0; r < c * c && compact; ++r) compact = first_[r + 1] - first_[r] <= 255;
-  if (compact) {
-    f.counts_.resize(static_cast<size_t>(c) * c);
-    for (int r = 0; r < c * c; ++r) f.counts_[r] = static_cast<uint8_t>(first_[r + 1] - first_[r]);
+  uint32_t most = 0;
+  for (int r = 0; r < c * c; ++r) most = std::max(most, first_[r + 1] - first_[r]);
+  if (most <= 255) {
+    const size_t rays = static_cast<size_t>(c) * c;
+    f.nibble_counts_ = most <= 15;
+    f.counts_.assign(f.nibble_counts_ ? rays / 2 : rays, 0);
+    for (size_t r = 0; r < rays; ++r) {
+      const uint32_t n = first_[r + 1] - first_[r];
+      if (f.nibble_counts_) f.counts_[r >> 1] |= static_cast<uint8_t>(n << ((r & 1) << 2));
+      else f.counts_[r] = static_cast<uint8_t>(n);
+    }
     f.row_first_.resize(static_cast<size_t>(c) + 1);
     for (int row = 0; row <= c; ++row) f.row_first_[row] = first_[static_cast<size_t>(row) * c];
   } else {

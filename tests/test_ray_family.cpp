@@ -1,0 +1,119 @@
+// RayFamily's storage: four-bit counts while no ray holds more than 15
+// points, byte counts past that, and the wide form (32-bit offsets) past 255.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <vector>
+
+#include "ldc/world.h"
+
+namespace ldc {
+namespace {
+
+struct Ray {
+  bool inside = false;
+  std::vector<PackedPoint> points;
+};
+
+PackedPoint point_at(uint16_t depth, bool exit) {
+  PackedPoint p;
+  p.depth = depth;
+  p.material = uint16_t(depth % 7);
+  p.normal = exit ? kPointExitBit : 0u;
+  return p;
+}
+
+// C*C rays, each empty with probability `empty`, else 1 .. max_points points.
+std::vector<Ray> random_rays(int c, double empty, int max_points, uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::uniform_int_distribution<int> n(1, max_points);
+  std::vector<Ray> rays(size_t(c) * c);
+  for (size_t r = 0; r < rays.size(); ++r) {
+    rays[r].inside = u(rng) < 0.3;
+    if (u(rng) < empty) continue;
+    const int k = n(rng);
+    for (int i = 0; i < k; ++i) rays[r].points.push_back(point_at(uint16_t(r * 3 + i + 1), i % 2 == 1));
+  }
+  return rays;
+}
+
+RayFamily write(int c, const std::vector<Ray>& rays) {
+  RayFamilyWriter wr(c);
+  for (const Ray& r : rays) {
+    wr.begin_ray(r.inside);
+    for (const PackedPoint& p : r.points) wr.add_point(p);
+  }
+  return wr.finish();
+}
+
+// Every ray's count, first point, points and start bit read back as written.
+void expect_reads_back(const RayFamily& f, const std::vector<Ray>& rays) {
+  ASSERT_EQ(f.check_structure(), "");
+  uint32_t first = 0;
+  for (size_t r = 0; r < rays.size(); ++r) {
+    const int ray = int(r);
+    ASSERT_EQ(f.point_count(ray), rays[r].points.size()) << "ray " << r;
+    ASSERT_EQ(f.first_point(ray), first) << "ray " << r;
+    ASSERT_EQ(f.starts_inside(ray), rays[r].inside) << "ray " << r;
+    const auto span = f.points(ray);
+    ASSERT_EQ(span.size(), rays[r].points.size());
+    for (size_t i = 0; i < span.size(); ++i) {
+      EXPECT_EQ(span[i].depth, rays[r].points[i].depth);
+      EXPECT_EQ(span[i].normal, rays[r].points[i].normal);
+    }
+    first += uint32_t(rays[r].points.size());
+  }
+  EXPECT_EQ(f.point_count(), first);
+}
+
+TEST(RayFamily, MostlyEmptyRaysReadBackAtEveryChunkSize) {
+  for (int c : {8, 16, 32, 64}) {
+    SCOPED_TRACE(c);
+    expect_reads_back(write(c, random_rays(c, 0.8, 4, uint32_t(c))), random_rays(c, 0.8, 4, uint32_t(c)));
+  }
+}
+
+TEST(RayFamily, FullAndSingleRayFamiliesReadBack) {
+  for (int c : {8, 32, 64}) {
+    SCOPED_TRACE(c);
+    const std::vector<Ray> full = random_rays(c, 0.0, 6, 7);
+    expect_reads_back(write(c, full), full);
+    std::vector<Ray> one(size_t(c) * c);
+    one.back().points = {point_at(5, false), point_at(9, true)};  // the very last ray only
+    expect_reads_back(write(c, one), one);
+  }
+}
+
+TEST(RayFamily, ARayOfMoreThan15PointsSwitchesToByteCounts) {
+  const int c = 32;
+  std::vector<Ray> rays = random_rays(c, 0.5, 15, 13);
+  expect_reads_back(write(c, rays), rays);
+  const size_t nibbles = write(c, rays).memory_bytes();
+  rays[77].points.clear();
+  for (int i = 0; i < 16; ++i) rays[77].points.push_back(point_at(uint16_t(i + 1), i % 2 == 1));
+  expect_reads_back(write(c, rays), rays);
+  EXPECT_GT(write(c, rays).memory_bytes(), nibbles + size_t(c) * c / 2 - 8);  // a byte per ray again
+}
+
+TEST(RayFamily, ARayOfMoreThan255PointsSwitchesToTheWideForm) {
+  const int c = 16;
+  std::vector<Ray> rays = random_rays(c, 0.5, 3, 11);
+  rays[40].points.clear();
+  for (int i = 0; i < 300; ++i) rays[40].points.push_back(point_at(uint16_t(i + 1), i % 2 == 1));
+  expect_reads_back(write(c, rays), rays);
+}
+
+TEST(RayFamily, CountsTakeHalfAByteARay) {
+  const int c = 32;
+  const std::vector<Ray> rays = random_rays(c, 0.7, 4, 3);
+  size_t points = 0;
+  for (const Ray& r : rays) points += r.points.size();
+  const size_t ray_count = size_t(c) * c;
+  // Four-bit counts, row offsets, start bits, points.
+  const size_t expected = ray_count / 2 + (size_t(c) + 1) * 4 + ray_count / 8 + points * 8;
+  EXPECT_EQ(write(c, rays).memory_bytes(), expected);
+}
+
+}  // namespace
+}  // namespace ldc
