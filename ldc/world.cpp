@@ -42,7 +42,7 @@ bool RayFamily::starts_inside(int ray) const {
   return (inside_[static_cast<size_t>(ray) >> 6] >> (ray & 63)) & 1u;
 }
 
-// Sum of the byte lanes of x (each at most 255 / 8 in use here).
+// Sum of the eight byte lanes of x (each at most 255).
 static uint32_t byte_sum(uint64_t x) {
   x = (x & 0x00FF00FF00FF00FFull) + ((x >> 8) & 0x00FF00FF00FF00FFull);
   x = (x & 0x0000FFFF0000FFFFull) + ((x >> 16) & 0x0000FFFF0000FFFFull);
