@@ -304,6 +304,41 @@ bool gather_cell_surface(const World& world, const glm::ivec3& cell, CellSurface
   return true;
 }
 
+namespace {
+
+// Direct-mapped: a lookup is one hash and one compare, and a miss costs a
+// gather as before. 64 entries hold a few rows of a camera's cells.
+struct SurfaceCache {
+  static constexpr size_t kEntries = 64;
+  struct Entry {
+    uint64_t stamp = 0;  // 0: empty (stamps start at 1)
+    glm::ivec3 cell{0};
+    bool has_surface = false;
+    CellSurface surface;
+  };
+  std::array<Entry, kEntries> entries;
+
+  static size_t slot(const glm::ivec3& c) {
+    const uint32_t h = uint32_t(c.x) * 73856093u ^ uint32_t(c.y) * 19349663u ^ uint32_t(c.z) * 83492791u;
+    return (h ^ (h >> 11)) & (kEntries - 1);
+  }
+};
+
+}  // namespace
+
+const CellSurface* cached_cell_surface(const World& world, const glm::ivec3& cell) {
+  thread_local std::unique_ptr<SurfaceCache> cache;  // on the heap: about 90 KB
+  if (!cache) cache = std::make_unique<SurfaceCache>();
+  SurfaceCache::Entry& e = cache->entries[SurfaceCache::slot(cell)];
+  const uint64_t stamp = world.stamp();
+  if (e.stamp != stamp || e.cell != cell) {
+    e.stamp = stamp;
+    e.cell = cell;
+    e.has_surface = gather_cell_surface(world, cell, &e.surface);
+  }
+  return e.has_surface ? &e.surface : nullptr;
+}
+
 double CellSurface::inside_value(const glm::dvec3& x, int* plane) const {
   // Convex: the largest plane value (inside all); concave and plane: the smallest.
   const bool use_max = shape == CellShape::kConvex;

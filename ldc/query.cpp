@@ -202,7 +202,6 @@ RayHit Queries::cast_checked(const Ray& ray) const {
   if (line_axis >= 0) {
     hit = cast_along_lattice_line(world, o, line_axis, d[line_axis] > 0.0, ray.max_distance / h);
   } else {
-    detail::CellSurface surface;
     uint16_t last_material = 0;
     // The normal of the cell face the walk entered through (back along the ray for the first cell).
     auto face_normal = [&](int entry_axis) {
@@ -220,12 +219,13 @@ RayHit Queries::cast_checked(const Ray& ray) const {
                            hit.normal = face_normal(entry_axis);
                            return true;
                          }
-                         if (!detail::gather_cell_surface(world, cell, &surface)) return false;
+                         const detail::CellSurface* surface = detail::cached_cell_surface(world, cell);
+                         if (!surface) return false;
                          const glm::dvec3 local = o - glm::dvec3(cell);
-                         detail::CellHit ch = detail::intersect_cell(surface, local, d, t0, t1);
-                         last_material = surface.planes[0].material;
+                         detail::CellHit ch = detail::intersect_cell(*surface, local, d, t0, t1);
+                         last_material = surface->planes[0].material;
                          if (!ch.hit) return false;
-                         const detail::CellPlane& plane = surface.planes[size_t(ch.plane)];
+                         const detail::CellPlane& plane = surface->planes[size_t(ch.plane)];
                          hit.hit = true;
                          hit.distance = ch.t;
                          hit.normal = glm::vec3(plane.n);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
+#include <thread>
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <gtest/gtest.h>
@@ -389,6 +390,43 @@ TEST(RayCast, AfterRandomEditsEqualsAFreshCache) {
       ASSERT_EQ(a.distance, c.distance) << "edit " << edit;
       ASSERT_EQ(a.material, c.material) << "edit " << edit;
     }
+  }
+}
+
+TEST(RayCast, CellSurfacesKeptByAThreadFollowEdits) {
+  // Neighbouring rays cross the same cells, whose surfaces this thread keeps
+  // between casts. A bundle aimed at each edit is cast just before it; after
+  // it, this thread's answers must equal a new thread's (which starts with
+  // nothing kept), and most must have changed (earlier edits may cover a spot).
+  WorldEditor editor(build_primitive(sphere(1.0, glm::dvec3(0.01, -0.02, 0.03)), 0.05));
+  Queries queries(editor.world());
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<double> u(-0.4, 0.4);
+  for (int edit = 0; edit < 8; ++edit) {
+    const glm::dvec3 at(u(rng), u(rng), 0.0);
+    std::vector<Ray> rays;
+    for (int y = -3; y <= 3; ++y)
+      for (int x = -3; x <= 3; ++x) rays.push_back({at + glm::dvec3(0.011 * x, 0.013 * y, 3.0), glm::dvec3(0.0, 0.0, -1.0)});
+    auto cast_all = [&] {
+      std::vector<RayHit> hits;
+      for (const Ray& r : rays) hits.push_back(queries.ray_cast(r).value());
+      return hits;
+    };
+    const std::vector<RayHit> before = cast_all();  // keeps this thread's cells
+    const glm::dvec3 top(at.x, at.y, std::sqrt(1.0 - at.x * at.x - at.y * at.y));
+    const EditOp op = edit % 2 ? EditOp::kUnion : EditOp::kSubtract;
+    ASSERT_TRUE(editor.apply(Brush::sphere(top, 0.2, uint16_t(edit + 1)), op).ok());
+    const std::vector<RayHit> here = cast_all();
+    std::vector<RayHit> fresh;
+    std::thread([&] { fresh = cast_all(); }).join();
+    size_t changed = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      ASSERT_EQ(here[i].hit, fresh[i].hit) << "edit " << edit << " ray " << i;
+      ASSERT_EQ(here[i].distance, fresh[i].distance) << "edit " << edit << " ray " << i;
+      ASSERT_EQ(here[i].material, fresh[i].material) << "edit " << edit << " ray " << i;
+      changed += here[i].distance != before[i].distance ? 1 : 0;
+    }
+    EXPECT_GT(changed, rays.size() / 2) << "edit " << edit << ": the rays should meet the edit";
   }
 }
 

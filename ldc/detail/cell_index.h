@@ -96,6 +96,13 @@ struct CellSurface {
 // and classifies their planes. Returns false when the cell holds no point.
 bool gather_cell_surface(const World& world, const glm::ivec3& cell, CellSurface* out);
 
+// gather_cell_surface through a small cache per thread of the cells it
+// gathered last, keyed by the world's content stamp (so an edit or another
+// world never reads a stale entry): neighbouring camera rays cross the same
+// cells. The surface stays valid until this thread's next call; nullptr when
+// the cell holds no point.
+const CellSurface* cached_cell_surface(const World& world, const glm::ivec3& cell);
+
 // First entry of x(t) = o + t*d into the cell's solid for t in [t0, t1]
 // (cell-local o). `plane` is the plane entered (its normal is the hit normal).
 struct CellHit {
