@@ -119,7 +119,9 @@ void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o,
     }
     if (t_next > t_stop) return;
     t = std::max(t, t_next);
-    cell = cell_at(t, block_lo, block_hi, axis);
+    // Out of one cell, the other coordinates stay (cell_at would clamp them
+    // to the cell's own); out of a bigger block, the exit point says.
+    if (block_hi - block_lo != glm::ivec3(1)) cell = cell_at(t, block_lo, block_hi, axis);
     cell[axis] = pos[axis] ? block_hi[axis] : block_lo[axis] - 1;
     if (cell[axis] < box_lo[axis] || cell[axis] >= box_hi[axis]) return;
     entry_axis = axis;
