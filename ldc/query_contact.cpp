@@ -109,7 +109,6 @@ bool any_surface_near(const Queries& q, const glm::dvec3& x, double reach) {
 // best point found soon rules out the rest without reading them.
 Nearest nearest_surface(const Queries& q, const glm::dvec3& x, double radius) {
   Nearest best;
-  CellSurface surface;
   std::vector<std::pair<double, glm::ivec3>> candidates;
   double reach = std::min(2.0, radius), searched = -1.0;
   for (;;) {
@@ -124,12 +123,13 @@ Nearest nearest_surface(const Queries& q, const glm::dvec3& x, double radius) {
               [](const auto& a, const auto& b) { return a.first < b.first; });
     for (const auto& [d2, cell] : candidates) {
       if (best.found && d2 >= best.distance2) break;
-      if (!detail::gather_cell_surface(q.world(), cell, &surface)) continue;
+      const CellSurface* surface = detail::cached_cell_surface(q.world(), cell);
+      if (!surface) continue;
       const glm::dvec3 cell_lo(cell);
       detail::CellClosest cc;
-      if (!detail::closest_in_cell(surface, x - cell_lo, &cc)) continue;
+      if (!detail::closest_in_cell(*surface, x - cell_lo, &cc)) continue;
       if (best.found && cc.distance2 >= best.distance2) continue;
-      const detail::CellPlane& plane = surface.planes[size_t(cc.plane)];
+      const detail::CellPlane& plane = surface->planes[size_t(cc.plane)];
       best = Nearest{true, cell_lo + cc.point, plane.n, plane.material, cc.distance2};
     }
     if ((best.found && best.distance2 <= reach * reach) || reach >= radius) break;
@@ -149,9 +149,9 @@ bool inside_solid(const Queries& q, const glm::dvec3& x) {
   if (index->clear) return index->clear_inside;
   const glm::ivec3 l = cell - k * c;
   if (!index->is_surface(l)) return index->is_inside(l);
-  CellSurface surface;
-  if (!detail::gather_cell_surface(q.world(), cell, &surface)) return index->is_inside(l);
-  return surface.contains(x - glm::dvec3(cell));
+  const CellSurface* surface = detail::cached_cell_surface(q.world(), cell);
+  if (!surface) return index->is_inside(l);
+  return surface->contains(x - glm::dvec3(cell));
 }
 
 // A convex shape for overlap tests, in lattice coordinates.
@@ -329,11 +329,23 @@ Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
   const double h = world_->lattice().cell_size;
   const glm::dvec3 dir = glm::normalize(ray.direction);
   const glm::dvec3 o = world_->lattice().to_lattice(ray.origin);
-  const double r = radius / h, t_max = ray.max_distance / h;
+  const double r = radius / h;
+  double t_max = ray.max_distance / h;
+  RayHit hit;
+  // Every cell outside the world's box is empty: once the sphere is more
+  // than r past the box, nothing can touch it (a miss used to take all
+  // kMaxCastSteps steps of at most 32 cells). Steps before are unchanged,
+  // so hits are exactly as before.
+  glm::dvec3 inv_d;
+  for (int a = 0; a < 3; ++a) inv_d[a] = dir[a] != 0.0 ? 1.0 / dir[a] : std::numeric_limits<double>::infinity();
+  const double grow = r + kContactGap + 1.0;
+  double t_in = 0.0;
+  if (!detail::clip_to_box(o, inv_d, glm::dvec3(world_->node_min() - 1) - grow,
+                           glm::dvec3(world_->node_end()) + grow, &t_in, &t_max))
+    return hit;
   // Conservative advancement: the sphere moves by its gap to the nearest
   // surface (by the search reach where none is near).
   const double search = r + 4.0;
-  RayHit hit;
   double t = 0.0;
   for (int step = 0; step < kMaxCastSteps; ++step) {
     const glm::dvec3 x = o + t * dir;

@@ -457,6 +457,28 @@ TEST(SphereCast, ContactDistanceMatchesTheAnalyticAnswer) {
   EXPECT_TRUE(queries.sphere_cast({glm::dvec3(-3, 1.2, 0), glm::dvec3(1, 0, 0)}, 0.25).value().hit);
 }
 
+TEST(SphereCast, FarFromTheWorldsBoxAndPastIt) {
+  // Everything outside the world's box is empty: a cast that leaves the box
+  // (grown by the radius) stops there, and one that never meets it misses.
+  const double h = 0.05, radius = 1.0;
+  World world = build_primitive(sphere(radius, glm::dvec3(0.0)), h);
+  Queries queries(world);
+  const glm::dvec3 d = glm::normalize(glm::dvec3(-1.0, -0.2, 0.1));
+  const glm::dvec3 far = -1000.0 * d;
+  for (double r : {0.1, 2.0, 5.0}) {
+    const RayHit hit = queries.sphere_cast({far, d}, r).value();
+    ASSERT_TRUE(hit.hit) << r;
+    EXPECT_NEAR(hit.distance, sphere_hit(far, d, glm::dvec3(0.0), radius + r), 0.2 * h) << r;
+  }
+  // Big spheres whose centres pass beside the box still touch the solid.
+  EXPECT_TRUE(queries.sphere_cast({glm::dvec3(-50, 2.9, 0), glm::dvec3(1, 0, 0)}, 2.0).value().hit);
+  EXPECT_FALSE(queries.sphere_cast({glm::dvec3(-50, 3.1, 0), glm::dvec3(1, 0, 0)}, 2.0).value().hit);
+  // Away from the box, past it, and along a face plane far outside.
+  EXPECT_FALSE(queries.sphere_cast({glm::dvec3(0, 0, 3), glm::dvec3(0, 0, 1)}, 0.5).value().hit);
+  EXPECT_FALSE(queries.sphere_cast({glm::dvec3(-9, 9, 9), glm::dvec3(1, 0, 0)}, 0.5).value().hit);
+  EXPECT_FALSE(queries.sphere_cast({glm::dvec3(0, 0, -5), glm::dvec3(0, 0, -1), 1e300}, 0.5).value().hit);
+}
+
 TEST(Overlap, SphereBoxAndCapsuleAgainstABox) {
   const double h = 0.05;
   World world = build_primitive(box_primitive(glm::dvec3(1.0)), h);  // top face at z = 1
