@@ -54,6 +54,7 @@
 #include "contour/contour.h"
 #include "contour/detail/remove_triangles.h"
 #include "contour/detail/triangle_intersection.h"
+#include "ldc/internal/huge_pages.h"
 
 namespace ldc {
 namespace {
@@ -137,11 +138,13 @@ struct Incidence {
 
 Incidence incidence(const Shared& s, size_t vertex_count) {
   Incidence table;
+  detail::reserve_on_huge_pages(table.offset, vertex_count + 1);
   table.offset.assign(vertex_count + 1, 0);
   for (size_t t = 0; t < s.tris.size(); ++t)
     if (s.tstate[t] != kFrozen)
       for (int k = 0; k < 3; ++k) ++table.offset[s.tris[t][k] + 1];
   for (size_t v = 0; v < vertex_count; ++v) table.offset[v + 1] += table.offset[v];
+  detail::reserve_on_huge_pages(table.tri, table.offset.back());
   table.tri.resize(table.offset.back());
   std::vector<size_t> next(table.offset.begin(), table.offset.end() - 1);
   for (size_t t = 0; t < s.tris.size(); ++t)
@@ -229,9 +232,13 @@ void add_initial_quadric(Shared& s, uint32_t v, const std::vector<EdgeEnd>& ends
 void analyse_vertices(Shared& s, const Incidence& table) {
   const size_t n = table.offset.size() - 1;
   s.vflags.assign(n, 0);
+  detail::reserve_on_huge_pages(s.quadric, n);
   s.quadric.assign(n, Quadric{});
+  detail::reserve_on_huge_pages(s.self_error, n);
   s.self_error.assign(n, 0.0);
-  std::vector<glm::dvec3> normal(s.tris.size());  // unit normals, each computed once
+  std::vector<glm::dvec3> normal;  // unit normals, each computed once
+  detail::reserve_on_huge_pages(normal, s.tris.size());
+  normal.resize(s.tris.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.tris.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t)
       if (s.tstate[t] != kFrozen) normal[t] = unit_normal(s.pos, s.tris[t]);
@@ -1289,6 +1296,7 @@ void init_shared(const ContourMesh& mesh, const SimplifyOptions& o, Shared& s) {
   s.pos = mesh.positions.data();
   s.material = mesh.triangle_material;
   s.material.resize(mesh.triangle_count(), 0);
+  detail::reserve_on_huge_pages(s.tris, mesh.triangles.size());
   s.tris = mesh.triangles;
   s.tstate.resize(s.tris.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.tris.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {

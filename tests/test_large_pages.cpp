@@ -4,43 +4,18 @@
 
 #include <cstdint>
 #include <cstdlib>
-#include <fstream>
 #include <memory>
-#include <sstream>
-#include <string>
 #include <vector>
 
 #include "large_pages.h"
+#include "thp_probe.h"
 
 namespace {
 
 using ldc::tool::kLargeBlock;
 
-// The THPeligible field of the /proc/self/smaps mapping holding p, or -1.
-int thp_eligible(const void* p) {
-  std::ifstream smaps("/proc/self/smaps");
-  const auto addr = reinterpret_cast<std::uintptr_t>(p);
-  std::string line;
-  bool inside = false;
-  while (std::getline(smaps, line)) {
-    std::uintptr_t lo = 0, hi = 0;
-    char dash = 0;
-    std::istringstream head(line);
-    if (head >> std::hex >> lo >> dash >> hi && dash == '-') {
-      inside = lo <= addr && addr < hi;
-      continue;
-    }
-    if (inside && line.rfind("THPeligible:", 0) == 0) return std::stoi(line.substr(12));
-  }
-  return -1;
-}
-
-std::string thp_mode() {
-  std::ifstream f("/sys/kernel/mm/transparent_hugepage/enabled");
-  std::string s;
-  std::getline(f, s);
-  return s;
-}
+using ldc::test::thp_eligible;
+using ldc::test::thp_mode;
 
 TEST(LargePages, LargeBlocksAreAlignedToHugePages) {
   std::vector<char> big(kLargeBlock + 1);
