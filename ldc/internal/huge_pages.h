@@ -1,12 +1,12 @@
 // Advice for a large array about to be filled: back it with transparent huge
-// pages. Where Linux's THP setting is "madvise" (Debian's and Ubuntu's
-// default), a fresh array is otherwise faulted in 4 KiB at a time, and on
-// the VMs we measure on each fault costs tens of microseconds: voxelize()'s
-// 52 MB occupancy grid of the bunny at 256 voxels took 12,800 faults, about
-// half of the call. Only whole 2 MiB pages inside the block are advised, so
-// memory grows by less than a page at each end; where THP is "always" or
-// "never", or off Linux, nothing changes. The library's allocator stays the
-// caller's: this advises memory already allocated, before it is touched.
+// pages. Where Linux's THP setting is "madvise" (as on the VMs we measure
+// on), a fresh array is otherwise faulted in 4 KiB at a time, at tens of
+// microseconds a fault there: voxelize()'s 52 MB occupancy grid of the bunny
+// at 256 voxels took 12,800 faults, about half of the call. Only the whole
+// 2 MiB pages inside the block are advised, and the caller fills all of it,
+// so no memory is added; where THP is "always" or "never", or off Linux,
+// nothing changes. The library's allocator stays the caller's: this advises
+// memory already allocated, before it is touched.
 #pragma once
 
 #include <cstddef>
