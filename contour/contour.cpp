@@ -12,6 +12,7 @@
 
 #include "contour/detail/mesh_patch.h"
 #include "contour/detail/region_mesher.h"
+#include "ldc/internal/huge_pages.h"
 #include "ldc/internal/ray_math.h"
 
 namespace ldc {
@@ -300,6 +301,10 @@ ContourMesh ChunkedMesh::assemble() const {
     return uint32_t(vbase[size_t(&m - chunks_.data())] + size_t(v - begin) + sheet);  // a cell's sheets are consecutive
   };
   ContourMesh out;
+  // Fresh arrays of tens of MB on a big world: advised onto huge pages first.
+  detail::reserve_on_huge_pages(out.positions, vbase[n]);
+  detail::reserve_on_huge_pages(out.normals, vbase[n]);
+  detail::reserve_on_huge_pages(out.triangles, tbase[n]);
   out.positions.resize(vbase[n]);
   out.normals.resize(vbase[n]);
   out.vertex_material.resize(vbase[n]);
