@@ -302,13 +302,10 @@ ContourMesh ChunkedMesh::assemble() const {
   };
   ContourMesh out;
   // Fresh arrays of tens of MB on a big world: advised onto huge pages first.
-  detail::reserve_on_huge_pages(out.positions, vbase[n]);
-  detail::reserve_on_huge_pages(out.normals, vbase[n]);
-  detail::reserve_on_huge_pages(out.triangles, tbase[n]);
-  out.positions.resize(vbase[n]);
-  out.normals.resize(vbase[n]);
+  detail::assign_on_huge_pages(out.positions, vbase[n]);
+  detail::assign_on_huge_pages(out.normals, vbase[n]);
+  detail::assign_on_huge_pages(out.triangles, tbase[n]);
   out.vertex_material.resize(vbase[n]);
-  out.triangles.resize(tbase[n]);
   out.triangle_material.resize(tbase[n]);
   tbb::parallel_for(size_t{0}, n, [&](size_t i) {
     const ChunkMesh& m = chunks_[i];

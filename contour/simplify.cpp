@@ -138,14 +138,12 @@ struct Incidence {
 
 Incidence incidence(const Shared& s, size_t vertex_count) {
   Incidence table;
-  detail::reserve_on_huge_pages(table.offset, vertex_count + 1);
-  table.offset.assign(vertex_count + 1, 0);
+  detail::assign_on_huge_pages(table.offset, vertex_count + 1);
   for (size_t t = 0; t < s.tris.size(); ++t)
     if (s.tstate[t] != kFrozen)
       for (int k = 0; k < 3; ++k) ++table.offset[s.tris[t][k] + 1];
   for (size_t v = 0; v < vertex_count; ++v) table.offset[v + 1] += table.offset[v];
-  detail::reserve_on_huge_pages(table.tri, table.offset.back());
-  table.tri.resize(table.offset.back());
+  detail::assign_on_huge_pages(table.tri, table.offset.back());
   std::vector<size_t> next(table.offset.begin(), table.offset.end() - 1);
   for (size_t t = 0; t < s.tris.size(); ++t)
     if (s.tstate[t] != kFrozen)
@@ -232,13 +230,10 @@ void add_initial_quadric(Shared& s, uint32_t v, const std::vector<EdgeEnd>& ends
 void analyse_vertices(Shared& s, const Incidence& table) {
   const size_t n = table.offset.size() - 1;
   s.vflags.assign(n, 0);
-  detail::reserve_on_huge_pages(s.quadric, n);
-  s.quadric.assign(n, Quadric{});
-  detail::reserve_on_huge_pages(s.self_error, n);
-  s.self_error.assign(n, 0.0);
+  detail::assign_on_huge_pages(s.quadric, n);
+  detail::assign_on_huge_pages(s.self_error, n);
   std::vector<glm::dvec3> normal;  // unit normals, each computed once
-  detail::reserve_on_huge_pages(normal, s.tris.size());
-  normal.resize(s.tris.size());
+  detail::assign_on_huge_pages(normal, s.tris.size());
   tbb::parallel_for(tbb::blocked_range<size_t>(0, s.tris.size(), 4096), [&](const tbb::blocked_range<size_t>& r) {
     for (size_t t = r.begin(); t != r.end(); ++t)
       if (s.tstate[t] != kFrozen) normal[t] = unit_normal(s.pos, s.tris[t]);

@@ -238,8 +238,7 @@ Result<VoxelGrid> voxelize(const World& world, const VoxelConfig& config, const 
   grid.voxel_size = config.voxel_size;
   grid.origin = world.lattice().origin;
   grid.has_faces = options.faces;
-  detail::reserve_on_huge_pages(grid.occupancy, box.count());
-  grid.occupancy.assign(box.count(), 0.0f);
+  detail::assign_on_huge_pages(grid.occupancy, box.count(), 0.0f);
   const std::vector<VoxelBox> blocks = detail::split_blocks(box, options.faces ? 16 : 32);
   const std::vector<detail::ObjectRef> objects = detail::object_refs(p, materials, config.axis);
   std::vector<std::vector<glm::ivec3>> surface(blocks.size());
@@ -336,10 +335,8 @@ Result<GBuffer> voxelize_gbuffer(const World& world, const VoxelConfig& config, 
   gb.box = box;
   gb.voxel_size = config.voxel_size;
   gb.origin = world.lattice().origin;
-  detail::reserve_on_huge_pages(gb.occupancy, box.count());
-  gb.occupancy.assign(box.count(), 0.0f);
-  detail::reserve_on_huge_pages(gb.faces, box.count() * kFaces);
-  gb.faces.assign(box.count() * kFaces, FaceSample{});
+  detail::assign_on_huge_pages(gb.occupancy, box.count(), 0.0f);
+  detail::assign_on_huge_pages(gb.faces, box.count() * kFaces);
   const std::vector<VoxelBox> blocks = detail::split_blocks(box, 16);
   const std::vector<detail::ObjectRef> objects = detail::object_refs(p, materials, config.axis);
   std::vector<std::vector<glm::ivec3>> surface(blocks.size());

@@ -28,4 +28,11 @@ void reserve_on_huge_pages(std::vector<T>& v, size_t n) {
   advise_huge_pages(v.data(), n * sizeof(T));
 }
 
+// v.assign(n, value) on an empty vector, its block advised first.
+template <class T>
+void assign_on_huge_pages(std::vector<T>& v, size_t n, const T& value = T{}) {
+  reserve_on_huge_pages(v, n);
+  v.assign(n, value);
+}
+
 }  // namespace ldc::detail
