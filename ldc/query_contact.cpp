@@ -336,8 +336,7 @@ Result<RayHit> Queries::sphere_cast(const Ray& ray, double radius) const {
   // than r past the box, nothing can touch it (a miss used to take all
   // kMaxCastSteps steps of at most 32 cells). Steps before are unchanged,
   // so hits are exactly as before.
-  glm::dvec3 inv_d;
-  for (int a = 0; a < 3; ++a) inv_d[a] = dir[a] != 0.0 ? 1.0 / dir[a] : std::numeric_limits<double>::infinity();
+  const glm::dvec3 inv_d = detail::inverse_direction(dir);
   const double grow = r + kContactGap + 1.0;
   double t_in = 0.0;
   if (!detail::clip_to_box(o, inv_d, glm::dvec3(world_->node_min() - 1) - grow,

@@ -34,6 +34,13 @@ inline bool clip_to_box(const glm::dvec3& o, const glm::dvec3& inv_d, const glm:
   return *t_in <= *t_out;
 }
 
+// 1 / d per axis, +inf where a component is zero (clip_to_box's input).
+inline glm::dvec3 inverse_direction(const glm::dvec3& d) {
+  glm::dvec3 inv;
+  for (int a = 0; a < 3; ++a) inv[a] = d[a] != 0.0 ? 1.0 / d[a] : std::numeric_limits<double>::infinity();
+  return inv;
+}
+
 // floor() for values well inside the int range, without a libm call.
 inline int fast_floor(double x) {
   const int i = static_cast<int>(x);
@@ -47,12 +54,8 @@ void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o,
   // Cells one layer below the box can hold surface: their far edges are the box's face rays.
   const glm::ivec3 box_lo = world.node_min() - 1, box_hi = world.node_end();
   // A zero component counts as positive with an infinite inverse: its exit time is +inf.
-  glm::dvec3 inv_d;
-  glm::bvec3 pos;
-  for (int a = 0; a < 3; ++a) {
-    pos[a] = d[a] >= 0.0;
-    inv_d[a] = d[a] != 0.0 ? 1.0 / d[a] : std::numeric_limits<double>::infinity();
-  }
+  const glm::dvec3 inv_d = inverse_direction(d);
+  const glm::bvec3 pos = glm::greaterThanEqual(d, glm::dvec3(0.0));
   double t = t_begin, t_stop = t_end;
   if (!clip_to_box(o, inv_d, glm::dvec3(box_lo), glm::dvec3(box_hi), &t, &t_stop)) return;
 
