@@ -45,6 +45,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <span>
 #include <string>
@@ -252,6 +253,31 @@ class ChunkedMesh {
   std::vector<ChunkMesh> chunks_;  // non-empty chunk meshes, sorted by chunk (z, y, x)
   ContourStats stats_;
 };
+
+// --- Chunks at different levels of detail (ldc/lod.h) ----------------------------
+//
+// The world meshed with each chunk at its own level, level_of_chunk(chunk)
+// in 0 .. max_lod_level(C) for every chunk of the world's box: a chunk at
+// level k is meshed from every 2^k-th ray (as contour_world meshes coarsen(
+// world, k)), and where chunks of different levels meet, the coarse cells
+// along the seam take the fine side's nodes on their shared faces and edges,
+// so the seam closes with no skirt: the mesh is a closed 2-manifold, like a
+// one-level mesh (contour/levels.cpp says why). Edits stay on `world` (level
+// 0); mesh again after them. Cost: coarsen() for each level used, then about
+// the cost of meshing each chunk at its level.
+//
+// Differences from contour_world: no relaxation of material borders (vertices
+// stay at their Hermite placement) and no local untangling round; with
+// config.untangle (the default), untangle_mesh runs on the whole result
+// (the vertices it moved are counted in stats->untangled_vertices).
+// config.chunked is ignored (always chunk by chunk, in parallel). Errors:
+// kInvalidArgument for a bad config, a missing function or a level out of
+// range (naming the chunk); kInvalidArgument from check_box_faces_outside;
+// kCancelled through ctx. Stage timer "contour_levels"; progress
+// "contour levels".
+Result<ContourMesh> contour_levels(const World& world, const std::function<int(const glm::ivec3&)>& level_of_chunk,
+                                   const ContourConfig& config = {}, Context* ctx = nullptr,
+                                   ContourStats* stats = nullptr);
 
 // Marching cubes on the same data (vertices at the edge crossings, faces
 // resolved consistently): the baseline for tests and benchmarks.

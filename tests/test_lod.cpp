@@ -3,8 +3,12 @@
 // with about 4^-k of the triangles.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
+#include <tuple>
+#include <vector>
 
 #include "contour/contour.h"
 #include "ldc/build.h"
@@ -186,6 +190,125 @@ TEST(Lod, ChunkDistanceIsToTheNearestPointOfItsBox) {
   EXPECT_DOUBLE_EQ(chunk_distance(lattice, 8, {0, 0, 0}, {2.0, 3.0, 4.0}), 0.0);  // inside
   EXPECT_DOUBLE_EQ(chunk_distance(lattice, 8, {1, 0, 0}, {2.0, 3.0, 4.0}), 3.0);  // box x from 5 m
   EXPECT_DOUBLE_EQ(chunk_distance(lattice, 8, {0, 0, 0}, {8.0, 10.0, 4.0}), 5.0);  // (3, 4, 0) away
+}
+
+// --- Chunks at different levels (contour_levels) ---------------------------------
+
+namespace levels_test {
+
+ContourConfig plain_config() {
+  ContourConfig c;
+  c.relax_iterations = 0;  // contour_levels does not relax material borders
+  c.untangle = false;
+  return c;
+}
+
+std::vector<glm::dvec3> sorted_positions(const ContourMesh& m) {
+  std::vector<glm::dvec3> p = m.positions;
+  std::sort(p.begin(), p.end(), [](const glm::dvec3& a, const glm::dvec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  });
+  return p;
+}
+
+// The largest distance from a vertex of `a` to the nearest vertex of `b`
+// (searched among those within `tolerance` in x; infinity when none is).
+double farthest_match(const ContourMesh& a, const ContourMesh& b, double tolerance) {
+  const std::vector<glm::dvec3> sorted = sorted_positions(b);
+  double worst = 0.0;
+  for (const glm::dvec3& p : a.positions) {
+    auto it = std::lower_bound(sorted.begin(), sorted.end(), p.x - tolerance,
+                               [](const glm::dvec3& q, double x) { return q.x < x; });
+    double best = std::numeric_limits<double>::infinity();
+    for (; it != sorted.end() && it->x <= p.x + tolerance; ++it) best = std::min(best, glm::length(*it - p));
+    worst = std::max(worst, best);
+  }
+  return worst;
+}
+
+// A level per chunk from a hash of its coordinates: every pairing of levels
+// across faces, edges and corners somewhere.
+int scrambled_level(const glm::ivec3& c, int levels, unsigned seed) {
+  unsigned h = unsigned(c.x) * 73856093u ^ unsigned(c.y) * 19349663u ^ unsigned(c.z) * 83492791u ^ seed * 2654435761u;
+  h ^= h >> 13;
+  h *= 0x5bd1e995u;
+  h ^= h >> 15;
+  return int(h % unsigned(levels));
+}
+
+}  // namespace levels_test
+
+// One level everywhere: the same mesh as contour_world on the coarse world
+// (positions to rounding: the planes are summed in another order).
+TEST(LodLevels, OneLevelEverywhereIsTheCoarseWorldsMesh) {
+  const World w = spot_world(96);
+  for (int level : {0, 1, 2}) {
+    ContourStats stats;
+    const ContourMesh mixed =
+        contour_levels(w, [&](const glm::ivec3&) { return level; }, levels_test::plain_config(), nullptr, &stats).value();
+    const ContourMesh uniform = contour_world(coarsen(w, level).value(), levels_test::plain_config()).value();
+    ASSERT_EQ(mixed.vertex_count(), uniform.vertex_count()) << "level " << level;
+    ASSERT_EQ(mixed.triangle_count(), uniform.triangle_count()) << "level " << level;
+    EXPECT_LT(levels_test::farthest_match(mixed, uniform, 1e-9 * w.lattice().cell_size), 1e-9 * w.lattice().cell_size)
+        << "level " << level;
+    EXPECT_GT(stats.cells, 0u);
+    EXPECT_LE(stats.cells, mixed.vertex_count());
+    EXPECT_GT(stats.quads, 0u);
+    EXPECT_NEAR(mesh_quality(mixed).volume, mesh_quality(uniform).volume, 1e-9 * mesh_quality(uniform).volume);
+  }
+}
+
+// Levels 0, 1 and 2 scattered over the chunks: the seams close. Without
+// untangling the mesh is a closed 2-manifold (no boundary, no non-manifold
+// edge or vertex); with it, also free of self-intersections.
+TEST(LodLevels, ScatteredLevelsMeshClosedAcrossEverySeam) {
+  const World w = spot_world(160);
+  for (unsigned seed : {1u, 2u, 3u}) {
+    auto level_of = [&](const glm::ivec3& c) { return levels_test::scrambled_level(c, 3, seed); };
+    const ContourMesh raw = contour_levels(w, level_of, levels_test::plain_config()).value();
+    const MeshQuality q = mesh_quality(raw);
+    EXPECT_TRUE(q.watertight()) << "seed " << seed << ": " << quality_failures(q);
+    EXPECT_EQ(q.nonmanifold_edges, 0u) << "seed " << seed;
+    EXPECT_EQ(q.nonmanifold_vertices, 0u) << "seed " << seed;
+    ContourMesh m = contour_levels(w, level_of).value();  // defaults: untangled
+    const MeshQuality qm = mesh_quality(m);
+    EXPECT_TRUE(qm.closed()) << "seed " << seed << ": " << quality_failures(qm);
+  }
+}
+
+// A ring of levels by distance from a point, as a camera would choose them,
+// on a landscape with caves and overhangs: closed, and between level 2's and
+// level 0's triangle counts.
+TEST(LodLevels, LevelsByDistanceOnALandscapeMeshClosed) {
+  TerrainConfig t;
+  t.size_x = t.size_y = 64.0;
+  const World w = build_terrain(t, 0.25, 32).value();
+  const LodBands bands{.start = {10.0, 24.0}, .hysteresis = 1.0};
+  const glm::dvec3 camera(20.0, 24.0, 8.0);
+  auto level_of = [&](const glm::ivec3& c) {
+    return lod_level(bands, chunk_distance(w.lattice(), w.chunk_size(), c, camera), 0);
+  };
+  ContourStats stats;
+  const ContourMesh m = contour_levels(w, level_of, {}, nullptr, &stats).value();
+  const MeshQuality q = mesh_quality(m);
+  EXPECT_TRUE(q.closed()) << quality_failures(q);
+  const size_t fine = contour_world(w).value().triangle_count();
+  const size_t coarse = contour_world(coarsen(w, 2).value()).value().triangle_count();
+  EXPECT_LT(q.triangles, fine / 2);
+  EXPECT_GT(q.triangles, coarse);
+  EXPECT_GT(stats.chunks_meshed, 0u);
+}
+
+TEST(LodLevels, ALevelOutOfRangeIsRefusedNamingTheChunk) {
+  const World w = spot_world(64);
+  Result<ContourMesh> r = contour_levels(w, [](const glm::ivec3& c) { return c == glm::ivec3(1, 0, 0) ? 3 : 0; });
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("chunk (1, 0, 0) has level 3, outside 0 .. 2"), std::string::npos)
+      << r.status().message();
+  Result<ContourMesh> none = contour_levels(w, nullptr);
+  ASSERT_FALSE(none.ok());
+  EXPECT_EQ(none.status().code(), ErrorCode::kInvalidArgument);
 }
 
 }  // namespace

@@ -1,0 +1,721 @@
+// contour_levels(): dual contouring of a world whose chunks sit at different
+// levels of detail, closed across the seams (see contour/contour.h).
+//
+// The cells form one conforming complex. A chunk at level k is tiled by cubes
+// of s = 2^k lattice cells. Where a cube's face lies on a chunk face whose
+// neighbour is finer, the face is cut into the neighbour's smaller squares
+// ("pieces"), and every side of a piece lying on a lattice line is cut at the
+// finest level of the chunks that touch that line. So both cells sharing a
+// piece see the same polygon of nodes, and every edge between two
+// consecutive nodes (a "minimal edge", of length 2^m) is an edge of the
+// level-m world, whose crossing coarsen() keeps exactly. The sheets of a cell
+// are the loops its polygons' segments close into (the face rule of
+// detail/cell_sheets.h, generalised from squares to polygons: each run of
+// inside nodes is cut off by one segment); one vertex per sheet, and one
+// polygon per crossing minimal edge, joining the sheets of the 3 or 4 cells
+// around it. That is the uniform mesher's argument for a closed 2-manifold,
+// unchanged: every segment lies on one polygon shared by two cells, and every
+// sheet is one loop. On a level-k world it gives contour_world's mesh of
+// coarsen(world, k) (tested, without relaxation and local untangling).
+#include <algorithm>
+#include <atomic>
+#include <bit>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include "contour/contour.h"
+#include "contour/detail/placement.h"
+#include "contour/detail/region.h"
+#include "ldc/lod.h"
+
+namespace ldc {
+namespace {
+
+using detail::CellPlanes;
+using detail::EdgeCrossing;
+using detail::Qef;
+using detail::Region;
+
+glm::ivec3 unit(int axis) {
+  glm::ivec3 e(0);
+  e[axis] = 1;
+  return e;
+}
+
+// The level of every chunk: the world's, and any other one as its nearest
+// chunk of the world (the layer below the box holds cells too).
+class LevelMap {
+ public:
+  Status build(const World& world, const std::function<int(const glm::ivec3&)>& level_of) {
+    origin_ = world.chunk_origin();
+    dims_ = world.chunk_dims();
+    shift_ = world.chunk_shift();
+    const int max_level = max_lod_level(world.chunk_size());
+    levels_.assign(size_t(dims_.x) * size_t(dims_.y) * size_t(dims_.z), 0);
+    for (int z = 0; z < dims_.z; ++z)
+      for (int y = 0; y < dims_.y; ++y)
+        for (int x = 0; x < dims_.x; ++x) {
+          const glm::ivec3 chunk = origin_ + glm::ivec3(x, y, z);
+          const int level = level_of(chunk);
+          if (level < 0 || level > max_level) {
+            return Status(ErrorCode::kInvalidArgument,
+                          "contour_levels: chunk (" + std::to_string(chunk.x) + ", " + std::to_string(chunk.y) +
+                              ", " + std::to_string(chunk.z) + ") has level " + std::to_string(level) +
+                              ", outside 0 .. " + std::to_string(max_level) + " for chunks of " +
+                              std::to_string(world.chunk_size()) + " cells");
+          }
+          levels_[index(chunk)] = int8_t(level);
+          highest_ = std::max(highest_, level);
+        }
+    return {};
+  }
+  int at(const glm::ivec3& chunk) const { return levels_[index(glm::clamp(chunk, origin_, origin_ + dims_ - 1))]; }
+  int highest() const { return highest_; }
+  int chunk_shift() const { return shift_; }
+  // The chunk holding the point 2 * doubled (coordinates in half lattice cells, never on a chunk face).
+  glm::ivec3 chunk_of_doubled(const glm::ivec3& doubled) const { return doubled >> (shift_ + 1); }
+
+ private:
+  size_t index(const glm::ivec3& c) const {
+    const glm::ivec3 r = c - origin_;
+    return (size_t(r.z) * size_t(dims_.y) + size_t(r.y)) * size_t(dims_.x) + size_t(r.x);
+  }
+  glm::ivec3 origin_{0}, dims_{1};
+  int shift_ = 5;
+  int highest_ = 0;
+  std::vector<int8_t> levels_;
+};
+
+// A cube of 2^level lattice cells with its lowest node at `lo` (level-0 nodes).
+struct Cell {
+  glm::ivec3 lo{0};
+  int level = 0;
+  int size() const { return 1 << level; }
+  bool operator==(const Cell&) const = default;
+};
+
+// The cell holding a point given in half lattice cells (off every cell face).
+Cell cell_at_doubled(const LevelMap& levels, const glm::ivec3& doubled) {
+  Cell c;
+  c.level = levels.at(levels.chunk_of_doubled(doubled));
+  c.lo = (doubled >> (c.level + 1)) << c.level;
+  return c;
+}
+
+// Signs and crossings of the level-0 lattice read from the coarse worlds:
+// an edge of length 2^m whose ends are multiples of 2^m is an edge of
+// coarsen(world, m), with its crossing as that world's contouring reads it.
+// Keeps the last few chunk regions loaded (least recently used goes first).
+class LevelReader {
+ public:
+  explicit LevelReader(const std::vector<const World*>* worlds) : worlds_(worlds) {}
+
+  bool inside(const glm::ivec3& node) {
+    const unsigned bits = unsigned(node.x) | unsigned(node.y) | unsigned(node.z);
+    const int m = std::min(std::countr_zero(bits), int(worlds_->size()) - 1);
+    const glm::ivec3 at = node >> m;
+    return region(m, at >> chunk_shift(m)).inside(at);
+  }
+  // The crossing of the edge from `lower` along `axis`, 2^level long.
+  const EdgeCrossing* crossing(const glm::ivec3& lower, int axis, int level) {
+    const glm::ivec3 at = lower >> level;
+    return region(level, at >> chunk_shift(level)).crossing(axis, at);
+  }
+  // Nodes [c C_m, (c + 1) C_m] of the level-m world (its chunk c, closed).
+  const Region& region(int level, const glm::ivec3& chunk) {
+    ++clock_;
+    for (Slot& s : slots_) {
+      if (s.level == level && s.chunk == chunk) {
+        s.used = clock_;
+        return *s.region;
+      }
+    }
+    Slot* slot = nullptr;
+    if (slots_.size() < kSlots) {
+      slots_.push_back({level, chunk, clock_, std::make_unique<Region>()});
+      slot = &slots_.back();
+    } else {
+      slot = &*std::min_element(slots_.begin(), slots_.end(),
+                                [](const Slot& a, const Slot& b) { return a.used < b.used; });
+      *slot = {level, chunk, clock_, std::move(slot->region)};
+    }
+    const World& w = *(*worlds_)[size_t(level)];
+    const int c = w.chunk_size();
+    slot->region->load(w, chunk * c, chunk * c + c + 1, chunk * c, chunk * c);
+    return *slot->region;
+  }
+
+ private:
+  static constexpr size_t kSlots = 32;
+  struct Slot {
+    int level;
+    glm::ivec3 chunk;
+    uint64_t used;
+    std::unique_ptr<Region> region;
+  };
+  int chunk_shift(int level) const { return (*worlds_)[size_t(level)]->chunk_shift(); }
+  const std::vector<const World*>* worlds_;
+  std::vector<Slot> slots_;
+  uint64_t clock_ = 0;
+};
+
+// --- One cell's polygons, crossings and sheets -----------------------------------
+
+struct CellCrossing {
+  glm::ivec3 lower{0};  // level-0 node
+  int axis = 0;
+  int level = 0;        // the edge is 2^level long
+  const EdgeCrossing* x = nullptr;
+  int next = -1;        // the crossing after this one on its loop
+  int sheet = -1;
+};
+
+struct Piece {
+  int begin = 0, end = 0;      // its nodes in CellShape::nodes, counter-clockwise seen from outside the cell
+  glm::ivec3 across_doubled;   // a point (half cells) inside the cell across the piece
+  glm::ivec4 key;              // axis, and the lowest corner: the same from both cells
+};
+
+struct CellShape {
+  Cell cell;
+  std::vector<glm::ivec3> nodes;
+  std::vector<Piece> pieces;
+  std::vector<uint8_t> in;           // per node
+  std::vector<int> edge_crossing;    // per node: crossing of the edge to the piece's next node, or -1
+  std::vector<CellCrossing> crossings;
+  int sheets = 0;
+};
+
+// The finest level among the chunks whose closed boxes hold the segment from
+// `a` along `axis` (its length divides the chunk size, so it lies in one
+// chunk interval along `axis`).
+int line_level(const LevelMap& levels, const glm::ivec3& a, int axis, int chunk_size) {
+  const int shift = levels.chunk_shift();
+  const glm::ivec3 base = a >> shift;
+  int level = 99;
+  const int u = axis_u(axis), v = axis_v(axis);
+  const int du = (a[u] & (chunk_size - 1)) == 0 ? 2 : 1, dv = (a[v] & (chunk_size - 1)) == 0 ? 2 : 1;
+  for (int i = 0; i < du; ++i)
+    for (int j = 0; j < dv; ++j) {
+      glm::ivec3 c = base;
+      c[u] -= i;
+      c[v] -= j;
+      level = std::min(level, levels.at(c));
+    }
+  return level;
+}
+
+// Appends one piece: a square of side q at `corner` on face (axis, side),
+// its sides cut at their lines' finest level.
+void add_piece(const LevelMap& levels, int chunk_size, int axis, int side, const glm::ivec3& corner, int q,
+               CellShape& shape) {
+  const int u = axis_u(axis), v = axis_v(axis);
+  // Counter-clockwise seen from outside: u then v on the +axis face, v then u on the -axis face.
+  const int first = side ? u : v, second = side ? v : u;
+  glm::ivec3 corners[4] = {corner, corner, corner, corner};
+  corners[1][first] += q;
+  corners[2][first] += q;
+  corners[2][second] += q;
+  corners[3][second] += q;
+  Piece piece;
+  piece.begin = int(shape.nodes.size());
+  for (int k = 0; k < 4; ++k) {
+    const glm::ivec3 from = corners[k], to = corners[(k + 1) % 4];
+    const int along = from[first] != to[first] ? first : second;
+    const int sign = to[along] > from[along] ? 1 : -1;
+    const int step = std::min(q, 1 << line_level(levels, glm::min(from, to), along, chunk_size));
+    for (int t = 0; t < q; t += step) {
+      glm::ivec3 n = from;
+      n[along] += sign * t;
+      shape.nodes.push_back(n);
+    }
+  }
+  piece.end = int(shape.nodes.size());
+  glm::ivec3 centre2 = 2 * corner;
+  centre2[u] += q;
+  centre2[v] += q;
+  centre2[axis] += side ? 1 : -1;
+  piece.across_doubled = centre2;
+  piece.key = glm::ivec4(axis, corner);
+  shape.pieces.push_back(piece);
+}
+
+// The cell's boundary as pieces: each face whole, or cut into the squares
+// of a finer chunk across it.
+void build_pieces(const LevelMap& levels, int chunk_size, const Cell& cell, CellShape& shape) {
+  shape.cell = cell;
+  shape.nodes.clear();
+  shape.pieces.clear();
+  const int s = cell.size();
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      glm::ivec3 across2 = 2 * cell.lo + glm::ivec3(s);
+      across2[axis] = side ? 2 * (cell.lo[axis] + s) + 1 : 2 * cell.lo[axis] - 1;
+      const int q = std::min(s, 1 << levels.at(levels.chunk_of_doubled(across2)));
+      const int u = axis_u(axis), v = axis_v(axis);
+      for (int i = 0; i < s; i += q)
+        for (int j = 0; j < s; j += q) {
+          glm::ivec3 corner = cell.lo;
+          corner[axis] += side * s;
+          corner[u] += i;
+          corner[v] += j;
+          add_piece(levels, chunk_size, axis, side, corner, q, shape);
+        }
+    }
+  }
+}
+
+int find_or_add_crossing(CellShape& shape, const glm::ivec3& a, const glm::ivec3& b, LevelReader& reader) {
+  const glm::ivec3 lower = glm::min(a, b);
+  const glm::ivec3 d = glm::abs(b - a);
+  const int axis = d.x ? 0 : d.y ? 1 : 2;
+  for (size_t i = 0; i < shape.crossings.size(); ++i) {
+    if (shape.crossings[i].lower == lower && shape.crossings[i].axis == axis) return int(i);
+  }
+  CellCrossing c;
+  c.lower = lower;
+  c.axis = axis;
+  c.level = std::countr_zero(unsigned(d[axis]));
+  c.x = reader.crossing(lower, axis, c.level);
+  shape.crossings.push_back(c);
+  return int(shape.crossings.size()) - 1;
+}
+
+// Node signs and the crossings of the edges whose ends differ. False when the
+// cell has none. A crossing with no point (the ends differ but the edge holds
+// none: a box face cut through the solid) leaves the cell unmeshed.
+bool read_crossings(LevelReader& reader, CellShape& shape) {
+  shape.in.resize(shape.nodes.size());
+  for (size_t i = 0; i < shape.nodes.size(); ++i) shape.in[i] = reader.inside(shape.nodes[i]);
+  shape.edge_crossing.assign(shape.nodes.size(), -1);
+  shape.crossings.clear();
+  for (const Piece& p : shape.pieces) {
+    for (int i = p.begin; i < p.end; ++i) {
+      const int j = i + 1 < p.end ? i + 1 : p.begin;
+      if (shape.in[size_t(i)] == shape.in[size_t(j)]) continue;
+      shape.edge_crossing[size_t(i)] = find_or_add_crossing(shape, shape.nodes[size_t(i)], shape.nodes[size_t(j)], reader);
+    }
+  }
+  for (const CellCrossing& c : shape.crossings)
+    if (!c.x) return false;
+  return !shape.crossings.empty();
+}
+
+// Pairs the crossings of each piece into segments (each run of inside nodes
+// cut off by one; on a joined piece each run of outside nodes instead) and
+// follows them into loops: shape.sheets loops, crossings[].sheet.
+void trace_sheets(CellShape& shape, const std::vector<uint8_t>& joined) {
+  for (CellCrossing& c : shape.crossings) c.next = c.sheet = -1;
+  for (size_t pi = 0; pi < shape.pieces.size(); ++pi) {
+    const Piece& p = shape.pieces[pi];
+    const int n = p.end - p.begin;
+    auto in = [&](int k) { return shape.in[size_t(p.begin + ((k % n) + n) % n)] != 0; };
+    auto crossing = [&](int k) { return shape.edge_crossing[size_t(p.begin + ((k % n) + n) % n)]; };
+    for (int k = 0; k < n; ++k) {
+      if (in(k) || !in(k + 1)) continue;  // entering the inside run at edge k
+      int j = k + 1;
+      if (joined[pi]) {
+        j = k;
+        while (!in(j - 1)) --j;
+        shape.crossings[size_t(crossing(k))].next = crossing(j - 1);
+      } else {
+        while (in(j + 1)) ++j;
+        shape.crossings[size_t(crossing(k))].next = crossing(j);
+      }
+    }
+  }
+  shape.sheets = 0;
+  for (CellCrossing& start : shape.crossings) {
+    if (start.sheet >= 0) continue;
+    for (CellCrossing* c = &start; c->sheet < 0; c = &shape.crossings[size_t(c->next)]) c->sheet = shape.sheets;
+    ++shape.sheets;
+  }
+}
+
+int crossing_index(const CellShape& shape, const glm::ivec3& lower, int axis) {
+  for (size_t i = 0; i < shape.crossings.size(); ++i)
+    if (shape.crossings[i].lower == lower && shape.crossings[i].axis == axis) return int(i);
+  return -1;
+}
+
+// The entering crossings of a piece (one per segment).
+void piece_segments(const CellShape& shape, const Piece& p, std::vector<int>& out) {
+  out.clear();
+  const int n = p.end - p.begin;
+  for (int k = 0; k < n; ++k) {
+    const size_t i = size_t(p.begin + k), j = size_t(p.begin + (k + 1) % n);
+    if (!shape.in[i] && shape.in[j]) out.push_back(shape.edge_crossing[i]);
+  }
+}
+
+// Whether two segments of piece `pi` lie on one loop of `shape` and on one
+// loop of the cell across, `other` (default rule both): their two vertices
+// would share two mesh edges, so the piece is joined from both sides instead.
+bool piece_links_twice(const CellShape& shape, size_t pi, CellShape& other, std::vector<int>& scratch) {
+  piece_segments(shape, shape.pieces[pi], scratch);
+  for (size_t a = 0; a < scratch.size(); ++a)
+    for (size_t b = a + 1; b < scratch.size(); ++b) {
+      const CellCrossing& ca = shape.crossings[size_t(scratch[a])];
+      const CellCrossing& cb = shape.crossings[size_t(scratch[b])];
+      if (ca.sheet != cb.sheet) continue;
+      const int oa = crossing_index(other, ca.lower, ca.axis), ob = crossing_index(other, cb.lower, cb.axis);
+      if (oa >= 0 && ob >= 0 && other.crossings[size_t(oa)].sheet == other.crossings[size_t(ob)].sheet) return true;
+    }
+  return false;
+}
+
+// --- Per chunk ---------------------------------------------------------------
+
+struct LevelVertex {
+  glm::dvec3 x{0.0};  // level-0 lattice coordinates
+  glm::vec3 normal{0.0f};
+  uint16_t material = 0;
+  glm::ivec3 cell_lo{0};
+  Qef qef;            // level-0 units, about cell_lo
+};
+
+struct OwnedEdge {
+  glm::ivec3 lower{0};
+  int axis = 0;
+  int level = 0;
+  bool lower_inside = false;
+  uint16_t material = 0;
+};
+
+struct ChunkPart {
+  std::vector<LevelVertex> vertices;
+  std::vector<std::pair<uint32_t, uint32_t>> keys;  // (edge and quadrant, vertex), sorted
+  std::vector<OwnedEdge> edges;
+  size_t first_vertex = 0;
+  size_t cells = 0;
+};
+
+// Quadrant q of the edge (lower, axis, 2^level) as a point in half cells:
+// counter-clockwise about +axis from (-u, -v).
+glm::ivec3 quadrant_point(const glm::ivec3& lower, int axis, int level, int q) {
+  static constexpr int kU[4] = {-1, 1, 1, -1}, kV[4] = {-1, -1, 1, 1};
+  glm::ivec3 p = 2 * lower;
+  p[axis] += 1 << level;
+  p[axis_u(axis)] += kU[q];
+  p[axis_v(axis)] += kV[q];
+  return p;
+}
+
+uint32_t quadrant_key(const glm::ivec3& lower, int axis, int q, const glm::ivec3& chunk, int chunk_size) {
+  const glm::ivec3 r = lower - chunk * chunk_size;  // 0 .. C: the edge lies on a cell of the chunk
+  return uint32_t(r.x) | uint32_t(r.y) << 7 | uint32_t(r.z) << 14 | uint32_t(axis) << 21 | uint32_t(q) << 23;
+}
+
+class ChunkMesher {
+ public:
+  ChunkMesher(const LevelMap* levels, const std::vector<const World*>* worlds, const ContourConfig* config)
+      : levels_(levels), reader_(worlds), chunk_size_((*worlds)[0]->chunk_size()), config_(config) {}
+
+  void mesh(const glm::ivec3& chunk, ChunkPart& out) {
+    out = ChunkPart();
+    chunk_ = chunk;
+    for (const Cell& cell : candidate_cells(chunk)) mesh_cell(cell, out);
+    std::sort(out.keys.begin(), out.keys.end());
+  }
+
+ private:
+  // Cells of the chunk next to a crossing edge of its own level, and its
+  // border cells when a neighbour is finer (their cut faces may hold more).
+  std::vector<Cell> candidate_cells(const glm::ivec3& chunk) {
+    const int level = levels_->at(chunk), s = 1 << level, n = chunk_size_ >> level;
+    std::vector<uint8_t> mark(size_t(n) * size_t(n) * size_t(n), 0);
+    auto mark_cell = [&](const glm::ivec3& c) {  // c in level-`level` cells, relative to the chunk
+      if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n))))
+        mark[(size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x)] = 1;
+    };
+    const std::vector<Region::EdgeRef> edges = reader_.region(level, chunk).crossing_edges();
+    for (const Region::EdgeRef& e : edges) {
+      const glm::ivec3 r = e.node - chunk * n;
+      const glm::ivec3 eu = unit(axis_u(e.axis)), ev = unit(axis_v(e.axis));
+      mark_cell(r);
+      mark_cell(r - eu);
+      mark_cell(r - ev);
+      mark_cell(r - eu - ev);
+    }
+    if (has_finer_neighbour(chunk, level)) {
+      for (int z = 0; z < n; ++z)
+        for (int y = 0; y < n; ++y)
+          for (int x = 0; x < n; ++x)
+            if (x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1) mark_cell({x, y, z});
+    }
+    std::vector<Cell> cells;
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x)
+          if (mark[(size_t(z) * size_t(n) + size_t(y)) * size_t(n) + size_t(x)])
+            cells.push_back({chunk * chunk_size_ + glm::ivec3(x, y, z) * s, level});
+    return cells;
+  }
+
+  bool has_finer_neighbour(const glm::ivec3& chunk, int level) const {
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          if (levels_->at(chunk + glm::ivec3(dx, dy, dz)) < level) return true;
+    return false;
+  }
+
+  // The cell's sheets under the default rule; false when it has no crossing.
+  bool default_sheets(const Cell& cell, CellShape& shape) {
+    build_pieces(*levels_, chunk_size_, cell, shape);
+    if (!read_crossings(reader_, shape)) return false;
+    no_joins_.assign(shape.pieces.size(), 0);
+    trace_sheets(shape, no_joins_);
+    return true;
+  }
+
+  void mesh_cell(const Cell& cell, ChunkPart& out) {
+    if (!default_sheets(cell, shape_)) return;
+    std::vector<uint8_t> joined(shape_.pieces.size(), 0);
+    bool any_joined = false;
+    for (size_t pi = 0; pi < shape_.pieces.size(); ++pi) {
+      piece_segments(shape_, shape_.pieces[pi], segments_);
+      if (segments_.size() < 2) continue;
+      const Cell across = cell_at_doubled(*levels_, shape_.pieces[pi].across_doubled);
+      if (!default_sheets(across, other_)) continue;
+      if (piece_links_twice(shape_, pi, other_, segments_)) joined[pi] = any_joined = 1;
+    }
+    if (any_joined) trace_sheets(shape_, joined);
+    ++out.cells;
+    const uint32_t first = uint32_t(out.vertices.size());
+    for (int sheet = 0; sheet < shape_.sheets; ++sheet) out.vertices.push_back(place(sheet));
+    record_edges(first, out);
+  }
+
+  LevelVertex place(int sheet) const {
+    const Cell& cell = shape_.cell;
+    const double s = cell.size();
+    std::vector<const CellCrossing*> on_loop;
+    for (const CellCrossing& c : shape_.crossings)
+      if (c.sheet == sheet) on_loop.push_back(&c);
+    CellPlanes unit_planes, planes;  // in cell units (placement), in lattice cells about cell.lo (quad split)
+    const size_t n = on_loop.size(), kept = std::min<size_t>(n, 12);
+    for (size_t i = 0; i < kept; ++i) {  // at most 12 planes: evenly spread over the loop
+      const CellCrossing& c = *on_loop[i * n / kept];
+      glm::dvec3 p = glm::dvec3(c.lower - cell.lo);
+      p[c.axis] += double(c.x->t) * double(1 << c.level);
+      unit_planes.add(p / s, glm::dvec3(c.x->normal), c.x->material);
+      planes.add(p, glm::dvec3(c.x->normal), c.x->material);
+    }
+    LevelVertex v;
+    const Qef unit_qef = Qef::of(unit_planes);
+    v.x = glm::dvec3(cell.lo) + s * detail::place_vertex(unit_planes, unit_qef, glm::dvec3(0.0), *config_).position;
+    v.normal = planes.mean_normal();
+    v.material = planes.majority_material();
+    v.cell_lo = cell.lo;
+    v.qef = Qef::of(planes);
+    return v;
+  }
+
+  // Keys for every quadrant the cell fills around each of its crossing
+  // edges; the edges whose (+u, +v) quadrant it fills are the chunk's to emit.
+  void record_edges(uint32_t first_vertex, ChunkPart& out) {
+    const Cell& cell = shape_.cell;
+    const glm::ivec3 lo2 = 2 * cell.lo, hi2 = 2 * (cell.lo + cell.size());
+    for (const CellCrossing& c : shape_.crossings) {
+      for (int q = 0; q < 4; ++q) {
+        const glm::ivec3 p = quadrant_point(c.lower, c.axis, c.level, q);
+        if (!glm::all(glm::greaterThan(p, lo2)) || !glm::all(glm::lessThan(p, hi2))) continue;
+        out.keys.emplace_back(quadrant_key(c.lower, c.axis, q, chunk_, chunk_size_), first_vertex + uint32_t(c.sheet));
+        if (q == 2) out.edges.push_back({c.lower, c.axis, c.level, reader_.inside(c.lower), c.x->material});
+      }
+    }
+  }
+
+  const LevelMap* levels_;
+  LevelReader reader_;
+  int chunk_size_;
+  const ContourConfig* config_;
+  glm::ivec3 chunk_{0};
+  CellShape shape_, other_;
+  std::vector<uint8_t> no_joins_;
+  std::vector<int> segments_;
+};
+
+// --- Polygons and assembly -----------------------------------------------------
+
+struct PolygonVertex {
+  uint32_t index;
+  const LevelVertex* v;
+};
+
+// Triangles of a quad: the diagonal whose midpoint fits the Hermite planes
+// of its two end cells best (ties: the shorter), as the uniform mesher does.
+bool split_along_02(const PolygonVertex p[4]) {
+  const glm::dvec3 m02 = 0.5 * (p[0].v->x + p[2].v->x), m13 = 0.5 * (p[1].v->x + p[3].v->x);
+  auto err = [&](int i, const glm::dvec3& m) { return p[i].v->qef.error(m - glm::dvec3(p[i].v->cell_lo)); };
+  const double e02 = err(0, m02) + err(2, m02), e13 = err(1, m13) + err(3, m13);
+  if (std::abs(e02 - e13) > 1e-9 * (1.0 + e02 + e13)) return e02 < e13;
+  return glm::length(p[0].v->x - p[2].v->x) <= glm::length(p[1].v->x - p[3].v->x);
+}
+
+class PolygonMaker {
+ public:
+  PolygonMaker(const LevelMap& levels, const std::vector<ChunkPart>& parts, const glm::ivec3& first_chunk,
+               const glm::ivec3& chunk_dims, int chunk_size)
+      : levels_(levels), parts_(parts), first_(first_chunk), dims_(chunk_dims), chunk_size_(chunk_size) {}
+
+  // The triangles of one crossing edge; false when a cell around it has no vertex (not expected).
+  bool emit(const OwnedEdge& e, std::vector<glm::uvec3>& tris, std::vector<uint16_t>& mats) const {
+    PolygonVertex ring[4];
+    int n = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int q = e.lower_inside ? k : 3 - k;  // counter-clockwise seen from outside the solid
+      PolygonVertex pv;
+      if (!lookup(e, q, pv)) return false;
+      if (n > 0 && ring[n - 1].index == pv.index) continue;
+      ring[n++] = pv;
+    }
+    if (n > 1 && ring[n - 1].index == ring[0].index) --n;
+    if (n < 3) return false;
+    if (n == 3) {
+      tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
+      mats.push_back(e.material);
+    } else if (split_along_02(ring)) {
+      tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
+      tris.emplace_back(ring[0].index, ring[2].index, ring[3].index);
+      mats.insert(mats.end(), 2, e.material);
+    } else {
+      tris.emplace_back(ring[0].index, ring[1].index, ring[3].index);
+      tris.emplace_back(ring[1].index, ring[2].index, ring[3].index);
+      mats.insert(mats.end(), 2, e.material);
+    }
+    return true;
+  }
+
+ private:
+  bool lookup(const OwnedEdge& e, int q, PolygonVertex& out) const {
+    const glm::ivec3 chunk = levels_.chunk_of_doubled(quadrant_point(e.lower, e.axis, e.level, q));
+    const glm::ivec3 r = chunk - first_;
+    if (glm::any(glm::lessThan(r, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(r, dims_))) return false;
+    const ChunkPart& part = parts_[(size_t(r.z) * size_t(dims_.y) + size_t(r.y)) * size_t(dims_.x) + size_t(r.x)];
+    const uint32_t key = quadrant_key(e.lower, e.axis, q, chunk, chunk_size_);
+    auto it = std::lower_bound(part.keys.begin(), part.keys.end(), std::make_pair(key, uint32_t{0}));
+    if (it == part.keys.end() || it->first != key) return false;
+    out.index = uint32_t(part.first_vertex + it->second);
+    out.v = &part.vertices[it->second];
+    return true;
+  }
+
+  const LevelMap& levels_;
+  const std::vector<ChunkPart>& parts_;
+  glm::ivec3 first_, dims_;
+  int chunk_size_;
+};
+
+ContourMesh assemble(const World& world, const std::vector<ChunkPart>& parts,
+                     const std::vector<std::vector<glm::uvec3>>& tris,
+                     const std::vector<std::vector<uint16_t>>& mats) {
+  ContourMesh mesh;
+  const Lattice& lattice = world.lattice();
+  for (const ChunkPart& part : parts) {
+    for (const LevelVertex& v : part.vertices) {
+      mesh.positions.push_back(lattice.to_world(v.x));
+      mesh.normals.push_back(v.normal);
+      mesh.vertex_material.push_back(v.material);
+    }
+  }
+  for (size_t i = 0; i < parts.size(); ++i) {
+    mesh.triangles.insert(mesh.triangles.end(), tris[i].begin(), tris[i].end());
+    mesh.triangle_material.insert(mesh.triangle_material.end(), mats[i].begin(), mats[i].end());
+  }
+  return mesh;
+}
+
+// The coarse worlds the levels need: [0] is `world` itself.
+Result<std::vector<World>> coarse_worlds(const World& world, int highest) {
+  std::vector<World> out;
+  for (int level = 1; level <= highest; ++level) {
+    Result<World> w = coarsen(world, level);
+    if (!w.ok()) return w.status();
+    out.push_back(std::move(w).value());
+  }
+  return out;
+}
+
+Result<ContourMesh> mesh_levels(const World& world, const LevelMap& levels, const ContourConfig& config,
+                                Context* ctx, ContourStats& stats) {
+  Result<std::vector<World>> coarse = coarse_worlds(world, levels.highest());
+  if (!coarse.ok()) return coarse.status();
+  std::vector<const World*> worlds = {&world};
+  for (const World& w : coarse.value()) worlds.push_back(&w);
+  // The world's chunks and the layer below the box, whose cells straddle its lower faces.
+  const glm::ivec3 first = world.chunk_origin() - 1, dims = world.chunk_dims() + 1;
+  const size_t count = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
+  auto chunk_at = [&](size_t i) {
+    return first + glm::ivec3(int(i % size_t(dims.x)), int(i / size_t(dims.x) % size_t(dims.y)),
+                              int(i / (size_t(dims.x) * size_t(dims.y))));
+  };
+  std::vector<ChunkPart> parts(count);
+  tbb::enumerable_thread_specific<ChunkMesher> meshers([&] { return ChunkMesher(&levels, &worlds, &config); });
+  std::atomic<size_t> done{0};
+  tbb::parallel_for(size_t{0}, count, [&](size_t i) {
+    if (ctx && ctx->cancelled()) return;
+    meshers.local().mesh(chunk_at(i), parts[i]);
+    const size_t n = done.fetch_add(1) + 1;
+    if (ctx && n % 16 == 0) ctx->report_progress("contour levels", double(n) / double(2 * count));
+  });
+  if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "contour_levels: cancelled");
+  size_t vertices = 0;
+  for (ChunkPart& p : parts) {
+    p.first_vertex = vertices;
+    vertices += p.vertices.size();
+    stats.cells += p.cells;
+    stats.chunks_meshed += p.cells > 0;
+  }
+  if (vertices > size_t(UINT32_MAX)) return Status(ErrorCode::kTooLarge, "contour_levels: over 2^32 vertices");
+  const PolygonMaker maker(levels, parts, first, dims, world.chunk_size());
+  std::vector<std::vector<glm::uvec3>> tris(count);
+  std::vector<std::vector<uint16_t>> mats(count);
+  std::atomic<size_t> missing{0};
+  tbb::parallel_for(size_t{0}, count, [&](size_t i) {
+    for (const OwnedEdge& e : parts[i].edges)
+      if (!maker.emit(e, tris[i], mats[i])) missing.fetch_add(1);
+  });
+  if (missing.load() > 0) {
+    return Status(ErrorCode::kInternal, "contour_levels: " + std::to_string(missing.load()) +
+                                            " crossing edges found no vertex in a cell around them");
+  }
+  for (const ChunkPart& p : parts) stats.quads += p.edges.size();
+  return assemble(world, parts, tris, mats);
+}
+
+}  // namespace
+
+Result<ContourMesh> contour_levels(const World& world, const std::function<int(const glm::ivec3&)>& level_of_chunk,
+                                   const ContourConfig& config, Context* ctx, ContourStats* stats) {
+  Status s = check_contour_config(config);
+  if (!s.ok()) return s;
+  if (!level_of_chunk) return Status(ErrorCode::kInvalidArgument, "contour_levels: no level function");
+  if (s = check_box_faces_outside(world); !s.ok()) return s;
+  try {
+    ScopedTimer timer(ctx, "contour_levels");
+    LevelMap levels;
+    if (s = levels.build(world, level_of_chunk); !s.ok()) return s;
+    ContourStats local;
+    Result<ContourMesh> mesh = mesh_levels(world, levels, config, ctx, local);
+    if (!mesh.ok()) return mesh.status();
+    if (config.untangle) {
+      Result<UntangleMeshStats> u = untangle_mesh(mesh.value(), {}, ctx);
+      if (!u.ok()) return u.status();
+      local.untangled_vertices = u.value().vertices_moved;
+    }
+    local.seconds = timer.seconds();
+    if (stats) *stats = local;
+    return mesh;
+  } catch (const std::bad_alloc&) {
+    return Status(ErrorCode::kTooLarge, "contour_levels: out of memory");
+  }
+}
+
+}  // namespace ldc
