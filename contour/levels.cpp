@@ -115,7 +115,20 @@ class LevelReader {
  public:
   explicit LevelReader(const std::vector<const World*>* worlds) : worlds_(worlds) {}
 
+  // Loads chunk `chunk` of the level-`level` world as the region looked at
+  // first (the chunk being meshed), kept apart from the recently used ones.
+  const Region& focus(int level, const glm::ivec3& chunk) {
+    const World& w = *(*worlds_)[size_t(level)];
+    const int c = w.chunk_size();
+    focus_.load(w, chunk * c, chunk * c + c + 1, chunk * c, chunk * c);
+    focus_level_ = level;
+    focus_lo_ = chunk * (c << level);
+    focus_hi_ = focus_lo_ + (c << level);
+    return focus_;
+  }
+
   bool inside(const glm::ivec3& node) {
+    if (in_focus(node)) return focus_.inside(node >> focus_level_);
     const unsigned bits = unsigned(node.x) | unsigned(node.y) | unsigned(node.z);
     const int m = std::min(std::countr_zero(bits), int(worlds_->size()) - 1);
     const glm::ivec3 at = node >> m;
@@ -123,15 +136,22 @@ class LevelReader {
   }
   // The crossing of the edge from `lower` along `axis`, 2^level long.
   const EdgeCrossing* crossing(const glm::ivec3& lower, int axis, int level) {
+    if (level == focus_level_ && in_focus(lower) && lower[axis] < focus_hi_[axis])
+      return focus_.crossing(axis, lower >> level);
     const glm::ivec3 at = lower >> level;
     return region(level, at >> chunk_shift(level)).crossing(axis, at);
   }
   // Nodes [c C_m, (c + 1) C_m] of the level-m world (its chunk c, closed).
   const Region& region(int level, const glm::ivec3& chunk) {
     ++clock_;
+    if (last_ < slots_.size() && slots_[last_].level == level && slots_[last_].chunk == chunk) {
+      slots_[last_].used = clock_;
+      return *slots_[last_].region;
+    }
     for (Slot& s : slots_) {
       if (s.level == level && s.chunk == chunk) {
         s.used = clock_;
+        last_ = size_t(&s - slots_.data());
         return *s.region;
       }
     }
@@ -147,10 +167,16 @@ class LevelReader {
     const World& w = *(*worlds_)[size_t(level)];
     const int c = w.chunk_size();
     slot->region->load(w, chunk * c, chunk * c + c + 1, chunk * c, chunk * c);
+    last_ = size_t(slot - slots_.data());
     return *slot->region;
   }
 
  private:
+  bool in_focus(const glm::ivec3& node) const {
+    const unsigned mask = (1u << focus_level_) - 1u;
+    return focus_level_ >= 0 && ((unsigned(node.x) | unsigned(node.y) | unsigned(node.z)) & mask) == 0 &&
+           glm::all(glm::greaterThanEqual(node, focus_lo_)) && glm::all(glm::lessThanEqual(node, focus_hi_));
+  }
   static constexpr size_t kSlots = 32;
   struct Slot {
     int level;
@@ -161,7 +187,11 @@ class LevelReader {
   int chunk_shift(int level) const { return (*worlds_)[size_t(level)]->chunk_shift(); }
   const std::vector<const World*>* worlds_;
   std::vector<Slot> slots_;
+  size_t last_ = 0;
   uint64_t clock_ = 0;
+  Region focus_;
+  int focus_level_ = -1;
+  glm::ivec3 focus_lo_{0}, focus_hi_{0};  // its closed box, level-0 nodes
 };
 
 // --- One cell's polygons, crossings and sheets -----------------------------------
@@ -210,6 +240,26 @@ int line_level(const LevelMap& levels, const glm::ivec3& a, int axis, int chunk_
   return level;
 }
 
+// Appends a face's one piece, its four corners only.
+void add_square(int axis, int side, const glm::ivec3& corner, int s, const glm::ivec3& across_doubled,
+                CellShape& shape) {
+  const int first = side ? axis_u(axis) : axis_v(axis), second = side ? axis_v(axis) : axis_u(axis);
+  Piece piece;
+  piece.begin = int(shape.nodes.size());
+  glm::ivec3 n = corner;
+  shape.nodes.push_back(n);
+  n[first] += s;
+  shape.nodes.push_back(n);
+  n[second] += s;
+  shape.nodes.push_back(n);
+  n[first] -= s;
+  shape.nodes.push_back(n);
+  piece.end = piece.begin + 4;
+  piece.across_doubled = across_doubled;
+  piece.key = glm::ivec4(axis, corner);
+  shape.pieces.push_back(piece);
+}
+
 // Appends one piece: a square of side q at `corner` on face (axis, side),
 // its sides cut at their lines' finest level.
 void add_piece(const LevelMap& levels, int chunk_size, int axis, int side, const glm::ivec3& corner, int q,
@@ -247,7 +297,9 @@ void add_piece(const LevelMap& levels, int chunk_size, int axis, int side, const
 
 // The cell's boundary as pieces: each face whole, or cut into the squares
 // of a finer chunk across it.
-void build_pieces(const LevelMap& levels, int chunk_size, const Cell& cell, CellShape& shape) {
+// `plain`: no chunk touching the cell is finer, so every face is one square
+// with its four corners (the common case, kept cheap).
+void build_pieces(const LevelMap& levels, int chunk_size, const Cell& cell, bool plain, CellShape& shape) {
   shape.cell = cell;
   shape.nodes.clear();
   shape.pieces.clear();
@@ -256,6 +308,12 @@ void build_pieces(const LevelMap& levels, int chunk_size, const Cell& cell, Cell
     for (int side = 0; side < 2; ++side) {
       glm::ivec3 across2 = 2 * cell.lo + glm::ivec3(s);
       across2[axis] = side ? 2 * (cell.lo[axis] + s) + 1 : 2 * cell.lo[axis] - 1;
+      if (plain) {
+        glm::ivec3 corner = cell.lo;
+        corner[axis] += side * s;
+        add_square(axis, side, corner, s, across2, shape);
+        continue;
+      }
       const int q = std::min(s, 1 << levels.at(levels.chunk_of_doubled(across2)));
       const int u = axis_u(axis), v = axis_v(axis);
       for (int i = 0; i < s; i += q)
@@ -419,6 +477,7 @@ class ChunkMesher {
   void mesh(const glm::ivec3& chunk, ChunkPart& out) {
     out = ChunkPart();
     chunk_ = chunk;
+    finer_neighbour_ = has_finer_neighbour(chunk, levels_->at(chunk));
     for (const Cell& cell : candidate_cells(chunk)) mesh_cell(cell, out);
     std::sort(out.keys.begin(), out.keys.end());
   }
@@ -433,8 +492,7 @@ class ChunkMesher {
       if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n))))
         mark[(size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x)] = 1;
     };
-    const std::vector<Region::EdgeRef> edges = reader_.region(level, chunk).crossing_edges();
-    for (const Region::EdgeRef& e : edges) {
+    for (const Region::EdgeRef& e : reader_.focus(level, chunk).crossing_edges()) {
       const glm::ivec3 r = e.node - chunk * n;
       const glm::ivec3 eu = unit(axis_u(e.axis)), ev = unit(axis_v(e.axis));
       mark_cell(r);
@@ -442,7 +500,7 @@ class ChunkMesher {
       mark_cell(r - ev);
       mark_cell(r - eu - ev);
     }
-    if (has_finer_neighbour(chunk, level)) {
+    if (finer_neighbour_) {
       for (int z = 0; z < n; ++z)
         for (int y = 0; y < n; ++y)
           for (int x = 0; x < n; ++x)
@@ -457,6 +515,18 @@ class ChunkMesher {
     return cells;
   }
 
+  // Whether no chunk finer than the cell touches it: true inside a chunk
+  // whose neighbours are no finer, and away from the chunk's faces.
+  bool is_plain(const Cell& cell) const {
+    const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
+    if (chunk != chunk_) return !has_finer_neighbour(chunk, cell.level) &&
+                                levels_->at(chunk) == cell.level;  // a cell across (conflict checks)
+    if (!finer_neighbour_) return true;
+    const glm::ivec3 r = cell.lo - chunk * chunk_size_;
+    return glm::all(glm::greaterThan(r, glm::ivec3(0))) &&
+           glm::all(glm::lessThan(r + cell.size(), glm::ivec3(chunk_size_)));
+  }
+
   bool has_finer_neighbour(const glm::ivec3& chunk, int level) const {
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
@@ -467,7 +537,7 @@ class ChunkMesher {
 
   // The cell's sheets under the default rule; false when it has no crossing.
   bool default_sheets(const Cell& cell, CellShape& shape) {
-    build_pieces(*levels_, chunk_size_, cell, shape);
+    build_pieces(*levels_, chunk_size_, cell, is_plain(cell), shape);
     if (!read_crossings(reader_, shape)) return false;
     no_joins_.assign(shape.pieces.size(), 0);
     trace_sheets(shape, no_joins_);
@@ -492,10 +562,11 @@ class ChunkMesher {
     record_edges(first, out);
   }
 
-  LevelVertex place(int sheet) const {
+  LevelVertex place(int sheet) {
     const Cell& cell = shape_.cell;
     const double s = cell.size();
-    std::vector<const CellCrossing*> on_loop;
+    std::vector<const CellCrossing*>& on_loop = on_loop_;
+    on_loop.clear();
     for (const CellCrossing& c : shape_.crossings)
       if (c.sheet == sheet) on_loop.push_back(&c);
     CellPlanes unit_planes, planes;  // in cell units (placement), in lattice cells about cell.lo (quad split)
@@ -537,9 +608,11 @@ class ChunkMesher {
   int chunk_size_;
   const ContourConfig* config_;
   glm::ivec3 chunk_{0};
+  bool finer_neighbour_ = false;  // of chunk_
   CellShape shape_, other_;
   std::vector<uint8_t> no_joins_;
   std::vector<int> segments_;
+  std::vector<const CellCrossing*> on_loop_;
 };
 
 // --- Polygons and assembly -----------------------------------------------------
