@@ -263,10 +263,11 @@ class ChunkedMesh {
 // along the seam take the fine side's nodes on their shared faces and edges,
 // so the seam closes with no skirt: the mesh is a closed 2-manifold, like a
 // one-level mesh (contour/levels.cpp says why). Edits stay on `world` (level
-// 0); mesh again after them. Cost: coarsen() for each level used, then about
-// the cost of meshing each chunk at its level.
+// 0); mesh again after them. Nothing is coarsened: each level's rays are
+// read from `world` in place. Cost: about that of meshing each chunk at its
+// level (a chunk beside a finer one costs more).
 //
-// Differences from contour_world: no relaxation of material borders (vertices
+// Differences from contour_world (and contour_chunk_levels from contour_chunk): no relaxation of material borders (vertices
 // stay at their Hermite placement) and no local untangling round; with
 // config.untangle (the default), untangle_mesh runs on the whole result
 // (the vertices it moved are counted in stats->untangled_vertices).
@@ -278,6 +279,25 @@ class ChunkedMesh {
 Result<ContourMesh> contour_levels(const World& world, const std::function<int(const glm::ivec3&)>& level_of_chunk,
                                    const ContourConfig& config = {}, Context* ctx = nullptr,
                                    ContourStats* stats = nullptr);
+
+// One chunk's part of contour_levels's mesh (before untangling), as
+// contour_chunk is of contour_world's: the polygons of the crossing edges the
+// chunk's cells emit, with the vertices of its own cells first
+// (own_vertices), then those of neighbouring chunks' cells that its polygons
+// use; vertex_cell is a vertex's cell's lowest node (level-0 lattice) and
+// vertex_sheet its sheet there. A vertex appears, bit for bit the same, in
+// every chunk mesh that uses it, so the chunk meshes of one level map
+// together are contour_levels's mesh and draw with no crack. A chunk's mesh
+// depends on the levels of the chunks up to 3 away (up to 2 but for rare
+// thin-tunnel faces), so when a chunk changes level, re-mesh the chunks
+// within 3 of it (within 2 they change as a rule). Reads the chunks up to 2
+// away; where these leave the world's box, the box faces must be outside
+// (check_box_faces_outside; a window cut through the ground is refused).
+// `chunk` may be any chunk of the box or of the layer below it
+// (kInvalidArgument otherwise). Thread-safe as contour_chunk.
+Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chunk,
+                                       const std::function<int(const glm::ivec3&)>& level_of_chunk,
+                                       const ContourConfig& config = {}, ContourStats* stats = nullptr);
 
 // Marching cubes on the same data (vertices at the edge crossings, faces
 // resolved consistently): the baseline for tests and benchmarks.

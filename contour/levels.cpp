@@ -20,9 +20,12 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <deque>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -51,9 +54,13 @@ glm::ivec3 unit(int axis) {
 // chunk of the world (the layer below the box holds cells too).
 class LevelMap {
  public:
-  Status build(const World& world, const std::function<int(const glm::ivec3&)>& level_of) {
-    origin_ = world.chunk_origin();
-    dims_ = world.chunk_dims();
+  // The chunks of the world's box within [lo, hi) (all of them by default).
+  Status build(const World& world, const std::function<int(const glm::ivec3&)>& level_of,
+               glm::ivec3 lo = glm::ivec3(INT32_MIN), glm::ivec3 hi = glm::ivec3(INT32_MAX)) {
+    lo = glm::max(lo, world.chunk_origin());
+    hi = glm::min(hi, world.chunk_origin() + world.chunk_dims());
+    origin_ = lo;
+    dims_ = hi - lo;
     shift_ = world.chunk_shift();
     const int max_level = max_lod_level(world.chunk_size());
     levels_.assign(size_t(dims_.x) * size_t(dims_.y) * size_t(dims_.z), 0);
@@ -107,30 +114,29 @@ Cell cell_at_doubled(const LevelMap& levels, const glm::ivec3& doubled) {
   return c;
 }
 
-// Signs and crossings of the level-0 lattice read from the coarse worlds:
-// an edge of length 2^m whose ends are multiples of 2^m is an edge of
-// coarsen(world, m), with its crossing as that world's contouring reads it.
-// Keeps the last few chunk regions loaded (least recently used goes first).
+// Signs and crossings of the lattice at each level: an edge of length 2^m
+// whose ends are multiples of 2^m is an edge of coarsen(world, m), read
+// with a Region of stride 2^m (the same crossing as that world's contouring
+// reads). Keeps the last few chunk regions loaded (least recently used goes
+// first).
 class LevelReader {
  public:
-  explicit LevelReader(const std::vector<const World*>* worlds) : worlds_(worlds) {}
+  LevelReader(const World* world, int highest_level) : world_(world), highest_(highest_level) {}
 
   // Loads chunk `chunk` of the level-`level` world as the region looked at
   // first (the chunk being meshed), kept apart from the recently used ones.
   const Region& focus(int level, const glm::ivec3& chunk) {
-    const World& w = *(*worlds_)[size_t(level)];
-    const int c = w.chunk_size();
-    focus_.load(w, chunk * c, chunk * c + c + 1, chunk * c, chunk * c);
+    load(focus_, level, chunk);
     focus_level_ = level;
-    focus_lo_ = chunk * (c << level);
-    focus_hi_ = focus_lo_ + (c << level);
+    focus_lo_ = chunk * world_->chunk_size();
+    focus_hi_ = focus_lo_ + world_->chunk_size();
     return focus_;
   }
 
   bool inside(const glm::ivec3& node) {
     if (in_focus(node)) return focus_.inside(node >> focus_level_);
     const unsigned bits = unsigned(node.x) | unsigned(node.y) | unsigned(node.z);
-    const int m = std::min(std::countr_zero(bits), int(worlds_->size()) - 1);
+    const int m = std::min(std::countr_zero(bits), highest_);
     const glm::ivec3 at = node >> m;
     return region(m, at >> chunk_shift(m)).inside(at);
   }
@@ -164,9 +170,7 @@ class LevelReader {
                                 [](const Slot& a, const Slot& b) { return a.used < b.used; });
       *slot = {level, chunk, clock_, std::move(slot->region)};
     }
-    const World& w = *(*worlds_)[size_t(level)];
-    const int c = w.chunk_size();
-    slot->region->load(w, chunk * c, chunk * c + c + 1, chunk * c, chunk * c);
+    load(*slot->region, level, chunk);
     last_ = size_t(slot - slots_.data());
     return *slot->region;
   }
@@ -184,8 +188,13 @@ class LevelReader {
     uint64_t used;
     std::unique_ptr<Region> region;
   };
-  int chunk_shift(int level) const { return (*worlds_)[size_t(level)]->chunk_shift(); }
-  const std::vector<const World*>* worlds_;
+  int chunk_shift(int level) const { return world_->chunk_shift() - level; }
+  void load(Region& region, int level, const glm::ivec3& chunk) const {
+    const int c = world_->chunk_size() >> level;
+    region.load(*world_, chunk * c, chunk * c + c + 1, chunk * c, chunk * c, 1 << level);
+  }
+  const World* world_;
+  int highest_;
   std::vector<Slot> slots_;
   size_t last_ = 0;
   uint64_t clock_ = 0;
@@ -434,6 +443,7 @@ struct LevelVertex {
   glm::vec3 normal{0.0f};
   uint16_t material = 0;
   glm::ivec3 cell_lo{0};
+  uint8_t sheet = 0;
   Qef qef;            // level-0 units, about cell_lo
 };
 
@@ -471,16 +481,37 @@ uint32_t quadrant_key(const glm::ivec3& lower, int axis, int q, const glm::ivec3
 
 class ChunkMesher {
  public:
-  ChunkMesher(const LevelMap* levels, const std::vector<const World*>* worlds, const ContourConfig* config)
-      : levels_(levels), reader_(worlds), chunk_size_((*worlds)[0]->chunk_size()), config_(config) {}
+  ChunkMesher(const LevelMap* levels, const World* world, const ContourConfig* config)
+      : levels_(levels), reader_(world, levels->highest()), chunk_size_(world->chunk_size()), config_(config) {}
 
   void mesh(const glm::ivec3& chunk, ChunkPart& out) {
     out = ChunkPart();
     chunk_ = chunk;
     finer_neighbour_ = has_finer_neighbour(chunk, levels_->at(chunk));
-    for (const Cell& cell : candidate_cells(chunk)) mesh_cell(cell, out);
+    for (const Cell& cell : candidate_cells(chunk)) mesh_cell(cell, true, out);
     std::sort(out.keys.begin(), out.keys.end());
   }
+
+  // The vertices of one cell (any chunk's) appended to out, with its keys;
+  // with emit_edges, also the crossing edges it emits.
+  void mesh_cell(const Cell& cell, bool emit_edges, ChunkPart& out) {
+    if (!default_sheets(cell, shape_)) return;
+    std::vector<uint8_t> joined(shape_.pieces.size(), 0);
+    bool any_joined = false;
+    for (size_t pi = 0; pi < shape_.pieces.size(); ++pi) {
+      piece_segments(shape_, shape_.pieces[pi], segments_);
+      if (segments_.size() < 2) continue;
+      const Cell across = cell_at_doubled(*levels_, shape_.pieces[pi].across_doubled);
+      if (!default_sheets(across, other_)) continue;
+      if (piece_links_twice(shape_, pi, other_, segments_)) joined[pi] = any_joined = 1;
+    }
+    if (any_joined) trace_sheets(shape_, joined);
+    ++out.cells;
+    const uint32_t first = uint32_t(out.vertices.size());
+    for (int sheet = 0; sheet < shape_.sheets; ++sheet) out.vertices.push_back(place(sheet));
+    record_edges(first, emit_edges, out);
+  }
+
 
  private:
   // Cells of the chunk next to a crossing edge of its own level, and its
@@ -544,23 +575,6 @@ class ChunkMesher {
     return true;
   }
 
-  void mesh_cell(const Cell& cell, ChunkPart& out) {
-    if (!default_sheets(cell, shape_)) return;
-    std::vector<uint8_t> joined(shape_.pieces.size(), 0);
-    bool any_joined = false;
-    for (size_t pi = 0; pi < shape_.pieces.size(); ++pi) {
-      piece_segments(shape_, shape_.pieces[pi], segments_);
-      if (segments_.size() < 2) continue;
-      const Cell across = cell_at_doubled(*levels_, shape_.pieces[pi].across_doubled);
-      if (!default_sheets(across, other_)) continue;
-      if (piece_links_twice(shape_, pi, other_, segments_)) joined[pi] = any_joined = 1;
-    }
-    if (any_joined) trace_sheets(shape_, joined);
-    ++out.cells;
-    const uint32_t first = uint32_t(out.vertices.size());
-    for (int sheet = 0; sheet < shape_.sheets; ++sheet) out.vertices.push_back(place(sheet));
-    record_edges(first, out);
-  }
 
   LevelVertex place(int sheet) {
     const Cell& cell = shape_.cell;
@@ -584,21 +598,24 @@ class ChunkMesher {
     v.normal = planes.mean_normal();
     v.material = planes.majority_material();
     v.cell_lo = cell.lo;
+    v.sheet = uint8_t(sheet);
     v.qef = Qef::of(planes);
     return v;
   }
 
-  // Keys for every quadrant the cell fills around each of its crossing
-  // edges; the edges whose (+u, +v) quadrant it fills are the chunk's to emit.
-  void record_edges(uint32_t first_vertex, ChunkPart& out) {
+  // Keys (about the cell's chunk) for every quadrant the cell fills around
+  // each of its crossing edges; with emit_edges, the edges whose (+u, +v)
+  // quadrant it fills, which its chunk emits.
+  void record_edges(uint32_t first_vertex, bool emit_edges, ChunkPart& out) {
     const Cell& cell = shape_.cell;
+    const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
     const glm::ivec3 lo2 = 2 * cell.lo, hi2 = 2 * (cell.lo + cell.size());
     for (const CellCrossing& c : shape_.crossings) {
       for (int q = 0; q < 4; ++q) {
         const glm::ivec3 p = quadrant_point(c.lower, c.axis, c.level, q);
         if (!glm::all(glm::greaterThan(p, lo2)) || !glm::all(glm::lessThan(p, hi2))) continue;
-        out.keys.emplace_back(quadrant_key(c.lower, c.axis, q, chunk_, chunk_size_), first_vertex + uint32_t(c.sheet));
-        if (q == 2) out.edges.push_back({c.lower, c.axis, c.level, reader_.inside(c.lower), c.x->material});
+        out.keys.emplace_back(quadrant_key(c.lower, c.axis, q, chunk, chunk_size_), first_vertex + uint32_t(c.sheet));
+        if (q == 2 && emit_edges) out.edges.push_back({c.lower, c.axis, c.level, reader_.inside(c.lower), c.x->material});
       }
     }
   }
@@ -632,58 +649,133 @@ bool split_along_02(const PolygonVertex p[4]) {
   return glm::length(p[0].v->x - p[2].v->x) <= glm::length(p[1].v->x - p[3].v->x);
 }
 
-class PolygonMaker {
+// The triangles of one crossing edge, its cells' vertices found by
+// lookup(e, quadrant, PolygonVertex&); false when a cell around it has no
+// vertex (not expected).
+template <class Lookup>
+bool emit_polygon(const OwnedEdge& e, Lookup&& lookup, std::vector<glm::uvec3>& tris, std::vector<uint16_t>& mats) {
+  PolygonVertex ring[4];
+  int n = 0;
+  for (int k = 0; k < 4; ++k) {
+    const int q = e.lower_inside ? k : 3 - k;  // counter-clockwise seen from outside the solid
+    PolygonVertex pv;
+    if (!lookup(e, q, pv)) return false;
+    if (n > 0 && ring[n - 1].index == pv.index) continue;
+    ring[n++] = pv;
+  }
+  if (n > 1 && ring[n - 1].index == ring[0].index) --n;
+  if (n < 3) return false;
+  if (n == 3) {
+    tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
+    mats.push_back(e.material);
+  } else if (split_along_02(ring)) {
+    tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
+    tris.emplace_back(ring[0].index, ring[2].index, ring[3].index);
+    mats.insert(mats.end(), 2, e.material);
+  } else {
+    tris.emplace_back(ring[0].index, ring[1].index, ring[3].index);
+    tris.emplace_back(ring[1].index, ring[2].index, ring[3].index);
+    mats.insert(mats.end(), 2, e.material);
+  }
+  return true;
+}
+
+// The vertex of `part` (its keys sorted) filling quadrant q of the edge, chunk `chunk`'s.
+bool find_in_part(const ChunkPart& part, const OwnedEdge& e, int q, const glm::ivec3& chunk, int chunk_size,
+                  PolygonVertex& out) {
+  const uint32_t key = quadrant_key(e.lower, e.axis, q, chunk, chunk_size);
+  auto it = std::lower_bound(part.keys.begin(), part.keys.end(), std::make_pair(key, uint32_t{0}));
+  if (it == part.keys.end() || it->first != key) return false;
+  out.index = uint32_t(part.first_vertex + it->second);
+  out.v = &part.vertices[it->second];
+  return true;
+}
+
+// Vertices for the whole world's polygons: every chunk's part, meshed first.
+class WorldParts {
  public:
-  PolygonMaker(const LevelMap& levels, const std::vector<ChunkPart>& parts, const glm::ivec3& first_chunk,
-               const glm::ivec3& chunk_dims, int chunk_size)
+  WorldParts(const LevelMap& levels, const std::vector<ChunkPart>& parts, const glm::ivec3& first_chunk,
+             const glm::ivec3& chunk_dims, int chunk_size)
       : levels_(levels), parts_(parts), first_(first_chunk), dims_(chunk_dims), chunk_size_(chunk_size) {}
 
-  // The triangles of one crossing edge; false when a cell around it has no vertex (not expected).
-  bool emit(const OwnedEdge& e, std::vector<glm::uvec3>& tris, std::vector<uint16_t>& mats) const {
-    PolygonVertex ring[4];
-    int n = 0;
-    for (int k = 0; k < 4; ++k) {
-      const int q = e.lower_inside ? k : 3 - k;  // counter-clockwise seen from outside the solid
-      PolygonVertex pv;
-      if (!lookup(e, q, pv)) return false;
-      if (n > 0 && ring[n - 1].index == pv.index) continue;
-      ring[n++] = pv;
-    }
-    if (n > 1 && ring[n - 1].index == ring[0].index) --n;
-    if (n < 3) return false;
-    if (n == 3) {
-      tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
-      mats.push_back(e.material);
-    } else if (split_along_02(ring)) {
-      tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
-      tris.emplace_back(ring[0].index, ring[2].index, ring[3].index);
-      mats.insert(mats.end(), 2, e.material);
-    } else {
-      tris.emplace_back(ring[0].index, ring[1].index, ring[3].index);
-      tris.emplace_back(ring[1].index, ring[2].index, ring[3].index);
-      mats.insert(mats.end(), 2, e.material);
-    }
-    return true;
-  }
-
- private:
-  bool lookup(const OwnedEdge& e, int q, PolygonVertex& out) const {
+  bool operator()(const OwnedEdge& e, int q, PolygonVertex& out) const {
     const glm::ivec3 chunk = levels_.chunk_of_doubled(quadrant_point(e.lower, e.axis, e.level, q));
     const glm::ivec3 r = chunk - first_;
     if (glm::any(glm::lessThan(r, glm::ivec3(0))) || glm::any(glm::greaterThanEqual(r, dims_))) return false;
     const ChunkPart& part = parts_[(size_t(r.z) * size_t(dims_.y) + size_t(r.y)) * size_t(dims_.x) + size_t(r.x)];
-    const uint32_t key = quadrant_key(e.lower, e.axis, q, chunk, chunk_size_);
-    auto it = std::lower_bound(part.keys.begin(), part.keys.end(), std::make_pair(key, uint32_t{0}));
-    if (it == part.keys.end() || it->first != key) return false;
-    out.index = uint32_t(part.first_vertex + it->second);
-    out.v = &part.vertices[it->second];
-    return true;
+    return find_in_part(part, e, q, chunk, chunk_size_, out);
   }
 
+ private:
   const LevelMap& levels_;
   const std::vector<ChunkPart>& parts_;
   glm::ivec3 first_, dims_;
   int chunk_size_;
+};
+
+// Vertices for one chunk's polygons: its own part's, then cells of the
+// neighbouring chunks meshed on first use and numbered after the chunk's own
+// vertices as polygons use them (kept in a deque: polygons hold pointers).
+class ChunkAndNeighbours {
+ public:
+  ChunkAndNeighbours(ChunkMesher& mesher, const LevelMap& levels, const ChunkPart& own, const glm::ivec3& chunk,
+                     int chunk_size)
+      : mesher_(mesher), levels_(levels), own_(own), chunk_(chunk), chunk_size_(chunk_size) {}
+
+  bool operator()(const OwnedEdge& e, int q, PolygonVertex& out) {
+    const glm::ivec3 p = quadrant_point(e.lower, e.axis, e.level, q);
+    const glm::ivec3 chunk = levels_.chunk_of_doubled(p);
+    if (chunk == chunk_) return find_in_part(own_, e, q, chunk, chunk_size_, out);
+    const Cell cell = cell_at_doubled(levels_, p);
+    auto [it, fresh] = cells_.try_emplace(std::make_tuple(cell.lo.x, cell.lo.y, cell.lo.z), KeyRange{});
+    if (fresh) it->second = mesh_foreign(cell);
+    const uint32_t key = quadrant_key(e.lower, e.axis, q, chunk, chunk_size_);
+    for (size_t k = it->second.begin; k < it->second.end; ++k) {
+      if (keys_[k].first != key) continue;
+      const uint32_t v = keys_[k].second;
+      if (index_[v] < 0) {
+        index_[v] = int32_t(own_.vertices.size() + used_.size());
+        used_.push_back(v);
+      }
+      out.index = uint32_t(index_[v]);
+      out.v = &vertices_[v];
+      return true;
+    }
+    return false;
+  }
+  // The neighbours' vertices the polygons used, in their numbering's order.
+  std::vector<const LevelVertex*> used() const {
+    std::vector<const LevelVertex*> out;
+    for (uint32_t v : used_) out.push_back(&vertices_[v]);
+    return out;
+  }
+
+ private:
+  struct KeyRange {
+    size_t begin = 0, end = 0;
+  };
+  KeyRange mesh_foreign(const Cell& cell) {
+    scratch_ = ChunkPart();
+    mesher_.mesh_cell(cell, false, scratch_);
+    const uint32_t base = uint32_t(vertices_.size());
+    vertices_.insert(vertices_.end(), scratch_.vertices.begin(), scratch_.vertices.end());
+    index_.resize(vertices_.size(), -1);
+    KeyRange r{keys_.size(), keys_.size() + scratch_.keys.size()};
+    for (const auto& [key, v] : scratch_.keys) keys_.emplace_back(key, base + v);
+    return r;
+  }
+
+  ChunkMesher& mesher_;
+  const LevelMap& levels_;
+  const ChunkPart& own_;
+  glm::ivec3 chunk_;
+  int chunk_size_;
+  std::map<std::tuple<int, int, int>, KeyRange> cells_;
+  std::deque<LevelVertex> vertices_;
+  std::vector<std::pair<uint32_t, uint32_t>> keys_;
+  std::vector<int32_t> index_;  // per vertex: its number in the chunk mesh, -1 until used
+  std::vector<uint32_t> used_;
+  ChunkPart scratch_;
 };
 
 ContourMesh assemble(const World& world, const std::vector<ChunkPart>& parts,
@@ -705,23 +797,26 @@ ContourMesh assemble(const World& world, const std::vector<ChunkPart>& parts,
   return mesh;
 }
 
-// The coarse worlds the levels need: [0] is `world` itself.
-Result<std::vector<World>> coarse_worlds(const World& world, int highest) {
-  std::vector<World> out;
-  for (int level = 1; level <= highest; ++level) {
-    Result<World> w = coarsen(world, level);
-    if (!w.ok()) return w.status();
-    out.push_back(std::move(w).value());
-  }
-  return out;
+// How far, in chunks, one chunk's mesh reads: its cells' faces and the
+// cells of its neighbours its polygons use (1), their faces' neighbours (2);
+// the levels it reads reach one chunk further (the cells across a face a
+// conflict check meshes).
+constexpr int kLevelReach = 2;
+constexpr int kLevelMapReach = 3;
+
+// The chunks contour_levels meshes: the world's and the layer below its box.
+bool chunk_is_meshable(const World& world, const glm::ivec3& chunk) {
+  const glm::ivec3 lo = world.chunk_origin() - 1, hi = world.chunk_origin() + world.chunk_dims();
+  return glm::all(glm::greaterThanEqual(chunk, lo)) && glm::all(glm::lessThan(chunk, hi));
+}
+
+bool reach_in_box(const World& world, const glm::ivec3& chunk, int reach) {
+  const glm::ivec3 lo = world.chunk_origin(), hi = world.chunk_origin() + world.chunk_dims();
+  return glm::all(glm::greaterThanEqual(chunk - reach, lo)) && glm::all(glm::lessThan(chunk + reach, hi));
 }
 
 Result<ContourMesh> mesh_levels(const World& world, const LevelMap& levels, const ContourConfig& config,
                                 Context* ctx, ContourStats& stats) {
-  Result<std::vector<World>> coarse = coarse_worlds(world, levels.highest());
-  if (!coarse.ok()) return coarse.status();
-  std::vector<const World*> worlds = {&world};
-  for (const World& w : coarse.value()) worlds.push_back(&w);
   // The world's chunks and the layer below the box, whose cells straddle its lower faces.
   const glm::ivec3 first = world.chunk_origin() - 1, dims = world.chunk_dims() + 1;
   const size_t count = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
@@ -730,7 +825,7 @@ Result<ContourMesh> mesh_levels(const World& world, const LevelMap& levels, cons
                               int(i / (size_t(dims.x) * size_t(dims.y))));
   };
   std::vector<ChunkPart> parts(count);
-  tbb::enumerable_thread_specific<ChunkMesher> meshers([&] { return ChunkMesher(&levels, &worlds, &config); });
+  tbb::enumerable_thread_specific<ChunkMesher> meshers([&] { return ChunkMesher(&levels, &world, &config); });
   std::atomic<size_t> done{0};
   tbb::parallel_for(size_t{0}, count, [&](size_t i) {
     if (ctx && ctx->cancelled()) return;
@@ -747,13 +842,13 @@ Result<ContourMesh> mesh_levels(const World& world, const LevelMap& levels, cons
     stats.chunks_meshed += p.cells > 0;
   }
   if (vertices > size_t(UINT32_MAX)) return Status(ErrorCode::kTooLarge, "contour_levels: over 2^32 vertices");
-  const PolygonMaker maker(levels, parts, first, dims, world.chunk_size());
+  const WorldParts lookup(levels, parts, first, dims, world.chunk_size());
   std::vector<std::vector<glm::uvec3>> tris(count);
   std::vector<std::vector<uint16_t>> mats(count);
   std::atomic<size_t> missing{0};
   tbb::parallel_for(size_t{0}, count, [&](size_t i) {
     for (const OwnedEdge& e : parts[i].edges)
-      if (!maker.emit(e, tris[i], mats[i])) missing.fetch_add(1);
+      if (!emit_polygon(e, lookup, tris[i], mats[i])) missing.fetch_add(1);
   });
   if (missing.load() > 0) {
     return Status(ErrorCode::kInternal, "contour_levels: " + std::to_string(missing.load()) +
@@ -788,6 +883,60 @@ Result<ContourMesh> contour_levels(const World& world, const std::function<int(c
     return mesh;
   } catch (const std::bad_alloc&) {
     return Status(ErrorCode::kTooLarge, "contour_levels: out of memory");
+  }
+}
+
+Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chunk,
+                                       const std::function<int(const glm::ivec3&)>& level_of_chunk,
+                                       const ContourConfig& config, ContourStats* stats) {
+  Status s = check_contour_config(config);
+  if (!s.ok()) return s;
+  if (!level_of_chunk) return Status(ErrorCode::kInvalidArgument, "contour_chunk_levels: no level function");
+  if (!chunk_is_meshable(world, chunk)) {
+    return Status(ErrorCode::kInvalidArgument, "contour_chunk_levels: chunk (" + std::to_string(chunk.x) + ", " +
+                                                   std::to_string(chunk.y) + ", " + std::to_string(chunk.z) +
+                                                   ") is outside the world's box and the layer below it");
+  }
+  if (!reach_in_box(world, chunk, kLevelReach)) {
+    if (s = check_box_faces_outside(world); !s.ok()) return s;
+  }
+  try {
+    ScopedTimer timer(nullptr, "contour_chunk_levels");
+    LevelMap levels;
+    if (s = levels.build(world, level_of_chunk, chunk - kLevelMapReach, chunk + kLevelMapReach + 1); !s.ok()) return s;
+    ChunkMesher mesher(&levels, &world, &config);
+    ChunkPart own;
+    mesher.mesh(chunk, own);
+    ChunkAndNeighbours lookup(mesher, levels, own, chunk, world.chunk_size());
+    ChunkMesh out;
+    out.chunk = chunk;
+    size_t missing = 0;
+    for (const OwnedEdge& e : own.edges)
+      if (!emit_polygon(e, lookup, out.mesh.triangles, out.mesh.triangle_material)) ++missing;
+    if (missing > 0) {
+      return Status(ErrorCode::kInternal, "contour_chunk_levels: " + std::to_string(missing) +
+                                              " crossing edges found no vertex in a cell around them");
+    }
+    out.own_vertices = own.vertices.size();
+    auto add = [&](const LevelVertex& v) {
+      out.mesh.positions.push_back(world.lattice().to_world(v.x));
+      out.mesh.normals.push_back(v.normal);
+      out.mesh.vertex_material.push_back(v.material);
+      out.vertex_cell.push_back(v.cell_lo);
+      out.vertex_sheet.push_back(v.sheet);
+    };
+    for (const LevelVertex& v : own.vertices) add(v);
+    for (const LevelVertex* v : lookup.used()) add(*v);
+    if (stats) {
+      *stats = ContourStats();
+      stats->cells = own.cells;
+      stats->quads = own.edges.size();
+      stats->chunks_meshed = 1;
+      stats->seconds = timer.seconds();
+    }
+    return out;
+  } catch (const std::bad_alloc&) {
+    return Status(ErrorCode::kTooLarge, "contour_chunk_levels: out of memory");
   }
 }
 

@@ -8,7 +8,7 @@
 namespace ldc::detail {
 
 void Region::load(const World& world, const glm::ivec3& lo, const glm::ivec3& hi,
-                  const glm::ivec3& count_lo, const glm::ivec3& count_hi) {
+                  const glm::ivec3& count_lo, const glm::ivec3& count_hi, int stride) {
   // Reused between loads: clear only the edge entries the last load set.
   for (const EdgeRef& e : edges_with_crossing_) edge_[e.axis][index(e.node)] = -1;
   lo_ = lo;
@@ -17,6 +17,7 @@ void Region::load(const World& world, const glm::ivec3& lo, const glm::ivec3& hi
   count_hi_ = count_hi;
   size_ = hi - lo;
   chunk_size_ = world.chunk_size();
+  stride_ = stride;
   const size_t n = size_t(size_.x) * size_t(size_.y) * size_t(size_.z);
   signs_.assign(n, 0);
   for (auto& e : edge_) {
@@ -26,7 +27,7 @@ void Region::load(const World& world, const glm::ivec3& lo, const glm::ivec3& hi
   edges_with_crossing_.clear();
   multi_ = thin_ = 0;
   cache_chunks(world);
-  const int c = chunk_size_;
+  const int c = chunk_size_ / stride_;
   for (int a = 0; a < 3; ++a) {
     const int u = axis_u(a), v = axis_v(a);
     // Tile by tile: the rays of one chunk column share their families.
@@ -41,9 +42,10 @@ void Region::load(const World& world, const glm::ivec3& lo, const glm::ivec3& hi
 // The rays of axis `axis` in one chunk column (tile (tu, tv) of the u, v
 // plane) that cross the region, walked row by row with running point offsets.
 void Region::load_tile(int axis, int tu, int tv) {
-  const int c = chunk_size_, u = axis_u(axis), v = axis_v(axis);
-  const int k0 = floor_div(lo_[axis], c), k1 = floor_div(hi_[axis] - 1, c);
-  const int64_t q = depth_steps_per_cell(c);
+  // c: chunk size in cells of the world; cn: in nodes of the region (cells of stride_).
+  const int c = chunk_size_, cn = c / stride_, u = axis_u(axis), v = axis_v(axis);
+  const int k0 = floor_div(lo_[axis], cn), k1 = floor_div(hi_[axis] - 1, cn);
+  const int64_t q = int64_t(depth_steps_per_cell(c)) * stride_;  // depth steps per region cell
   const int64_t lo = int64_t(lo_[axis]) * q, hi = int64_t(hi_[axis]) * q;
   const int span = k1 - k0 + 1;  // 2 or 3 for a chunk, more for a whole world
   std::vector<const RayFamily*>& fam = tile_families_;
@@ -61,14 +63,18 @@ void Region::load_tile(int axis, int tu, int tv) {
     fam[k - k0] = data ? &data->axis[axis] : nullptr;
     uniform_inside[k - k0] = data ? false : kind_at(ch) == ChunkKind::kSolid;
   }
-  const int u_lo = std::max(lo_[u], tu * c), u_hi = std::min(hi_[u], tu * c + c);
-  const int v_lo = std::max(lo_[v], tv * c), v_hi = std::min(hi_[v], tv * c + c);
+  const int u_lo = std::max(lo_[u], tu * cn), u_hi = std::min(hi_[u], tu * cn + cn);
+  const int v_lo = std::max(lo_[v], tv * cn), v_hi = std::min(hi_[v], tv * cn + cn);
   std::vector<RayPoint>& pts = scratch_;
   for (int rv = v_lo; rv < v_hi; ++rv) {
-    const int row = (rv - tv * c) * c;
-    for (int k = 0; k < span; ++k) offset[k] = fam[k] ? fam[k]->first_point(row + (u_lo - tu * c)) : 0;
+    const int row = (rv - tv * cn) * stride_ * c;
+    int at = row + (u_lo - tu * cn) * stride_;  // the family ray `offset` points at
+    for (int k = 0; k < span; ++k) offset[k] = fam[k] ? fam[k]->first_point(at) : 0;
     for (int ru = u_lo; ru < u_hi; ++ru) {
-      const int ray = row + (ru - tu * c);
+      const int ray = row + (ru - tu * cn) * stride_;
+      for (; at < ray; ++at)  // rays between every stride-th one (none at stride 1)
+        for (int k = 0; k < span; ++k)
+          if (fam[k]) offset[k] += fam[k]->point_count(at);
       bool state = fam[0] ? fam[0]->starts_inside(ray) : uniform_inside[0];
       pts.clear();
       for (int k = 0; k < span; ++k) {
@@ -83,6 +89,7 @@ void Region::load_tile(int axis, int tu, int tv) {
           else if (d < hi) pts.push_back({double(d) / double(q), &p[i]});
         }
       }
+      at = ray + 1;
       glm::ivec3 first;
       first[axis] = lo_[axis];
       first[u] = ru;
@@ -93,7 +100,7 @@ void Region::load_tile(int axis, int tu, int tv) {
 }
 
 void Region::cache_chunks(const World& world) {
-  const int c = chunk_size_;
+  const int c = chunk_size_ / stride_;  // in region nodes
   chunk_lo_ = glm::ivec3(floor_div(lo_.x, c), floor_div(lo_.y, c), floor_div(lo_.z, c));
   glm::ivec3 chunk_hi(floor_div(hi_.x - 1, c), floor_div(hi_.y - 1, c), floor_div(hi_.z - 1, c));
   chunk_dims_ = chunk_hi - chunk_lo_ + 1;

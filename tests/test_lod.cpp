@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -297,6 +298,68 @@ TEST(LodLevels, LevelsByDistanceOnALandscapeMeshClosed) {
   EXPECT_LT(q.triangles, fine / 2);
   EXPECT_GT(q.triangles, coarse);
   EXPECT_GT(stats.chunks_meshed, 0u);
+}
+
+namespace levels_test {
+
+using Triangle = std::array<glm::dvec3, 3>;
+
+// A triangle by its corners' positions, turned to start at the smallest.
+Triangle canonical(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
+  auto less = [](const glm::dvec3& p, const glm::dvec3& q) { return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z); };
+  Triangle t{a, b, c};
+  while (less(t[1], t[0]) || less(t[2], t[0])) t = {t[1], t[2], t[0]};
+  return t;
+}
+
+bool triangle_less(const Triangle& a, const Triangle& b) {
+  for (int i = 0; i < 3; ++i) {
+    if (a[i] != b[i]) return std::tie(a[i].x, a[i].y, a[i].z) < std::tie(b[i].x, b[i].y, b[i].z);
+  }
+  return false;
+}
+
+void add_triangles(const ContourMesh& m, std::vector<Triangle>& out) {
+  for (const glm::uvec3& t : m.triangles) out.push_back(canonical(m.positions[t.x], m.positions[t.y], m.positions[t.z]));
+}
+
+}  // namespace levels_test
+
+// Chunk by chunk (an engine's way): the chunk meshes together are the whole
+// mesh, triangle for triangle with the same positions to the bit, so they
+// draw with no crack; each chunk's own vertices are its cells'.
+TEST(LodLevels, ChunkMeshesTogetherAreTheWholeMesh) {
+  const World w = spot_world(160);
+  auto level_of = [&](const glm::ivec3& c) { return levels_test::scrambled_level(c, 3, 7); };
+  const ContourMesh whole = contour_levels(w, level_of, levels_test::plain_config()).value();
+  std::vector<levels_test::Triangle> expected, got;
+  levels_test::add_triangles(whole, expected);
+  size_t own = 0;
+  for (int z = w.chunk_origin().z - 1; z < w.chunk_origin().z + w.chunk_dims().z; ++z)
+    for (int y = w.chunk_origin().y - 1; y < w.chunk_origin().y + w.chunk_dims().y; ++y)
+      for (int x = w.chunk_origin().x - 1; x < w.chunk_origin().x + w.chunk_dims().x; ++x) {
+        Result<ChunkMesh> m = contour_chunk_levels(w, {x, y, z}, level_of, levels_test::plain_config());
+        ASSERT_TRUE(m.ok()) << m.status().message();
+        const ChunkMesh& cm = m.value();
+        ASSERT_EQ(cm.vertex_cell.size(), cm.mesh.positions.size());
+        for (size_t i = 0; i < cm.own_vertices; ++i)
+          EXPECT_EQ(cm.vertex_cell[i] >> w.chunk_shift(), glm::ivec3(x, y, z)) << "chunk " << x << "," << y << "," << z;
+        own += cm.own_vertices;
+        levels_test::add_triangles(cm.mesh, got);
+      }
+  EXPECT_EQ(own, whole.vertex_count());
+  std::sort(expected.begin(), expected.end(), levels_test::triangle_less);
+  std::sort(got.begin(), got.end(), levels_test::triangle_less);
+  ASSERT_EQ(got.size(), expected.size());
+  EXPECT_TRUE(got == expected);
+}
+
+TEST(LodLevels, AChunkOutsideTheMeshableBoxIsRefused) {
+  const World w = spot_world(64);
+  Result<ChunkMesh> r = contour_chunk_levels(w, w.chunk_origin() - 2, [](const glm::ivec3&) { return 0; });
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("outside the world's box"), std::string::npos) << r.status().message();
 }
 
 TEST(LodLevels, ALevelOutOfRangeIsRefusedNamingTheChunk) {

@@ -23,8 +23,12 @@ class Region {
  public:
   // Reads nodes [lo, hi) (global node coordinates, hi exclusive). Edge counts
   // (multi-crossing, thin) cover only edges whose lower node is in [count_lo, count_hi).
+  // With a stride s (a power of two dividing the chunk size), the region's
+  // node n is the world's node s n and its edges are s cells long: the
+  // lattice of coarsen(world, log2 s), read from `world` as that world's
+  // Region would read it (the same signs and crossings).
   void load(const World& world, const glm::ivec3& lo, const glm::ivec3& hi,
-            const glm::ivec3& count_lo, const glm::ivec3& count_hi);
+            const glm::ivec3& count_lo, const glm::ivec3& count_hi, int stride = 1);
 
   glm::ivec3 lo() const { return lo_; }
   glm::ivec3 hi() const { return hi_; }
@@ -99,7 +103,8 @@ class Region {
   }
 
   glm::ivec3 lo_{0}, hi_{0}, size_{0}, count_lo_{0}, count_hi_{0};
-  int chunk_size_ = 32;
+  int chunk_size_ = 32;  // of the world, in its cells
+  int stride_ = 1;
   // The chunks the region overlaps, so rays need no lookups in the world's table.
   glm::ivec3 chunk_lo_{0}, chunk_dims_{0};
   std::vector<const Chunk*> chunks_;
