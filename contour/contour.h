@@ -288,11 +288,12 @@ Result<ContourMesh> contour_levels(const World& world, const std::function<int(c
 // vertex_sheet its sheet there. A vertex appears, bit for bit the same, in
 // every chunk mesh that uses it, so the chunk meshes of one level map
 // together are contour_levels's mesh and draw with no crack. A chunk's mesh
-// depends on the levels of the chunks up to 3 away (up to 2 but for rare
-// thin-tunnel faces), so when a chunk changes level, re-mesh the chunks
-// within 3 of it (within 2 they change as a rule). Reads the chunks up to 2
-// away; where these leave the world's box, the box faces must be outside
-// (check_box_faces_outside; a window cut through the ground is refused).
+// depends only on the rays and the levels of the chunk and its 26
+// neighbours (everything it meshes lies within two cells of it, and a cell
+// is at most C / 8 wide), so when a chunk changes level or its rays change,
+// re-mesh it and its 26 neighbours. Where those neighbours leave the world's
+// box, the box faces must be outside (check_box_faces_outside; a window cut
+// through the ground is refused there).
 // `chunk` may be any chunk of the box or of the layer below it
 // (kInvalidArgument otherwise). Thread-safe as contour_chunk.
 Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chunk,

@@ -797,12 +797,15 @@ ContourMesh assemble(const World& world, const std::vector<ChunkPart>& parts,
   return mesh;
 }
 
-// How far, in chunks, one chunk's mesh reads: its cells' faces and the
-// cells of its neighbours its polygons use (1), their faces' neighbours (2);
-// the levels it reads reach one chunk further (the cells across a face a
-// conflict check meshes).
-constexpr int kLevelReach = 2;
-constexpr int kLevelMapReach = 3;
+// How far, in chunks, one chunk's mesh reaches. It meshes its own cells,
+// the cells of neighbouring chunks that its polygons use (each shares an edge
+// with one of its cells), and the cells across their faces (conflict
+// checks): all within two cells of the chunk, and a cell is at most C / 8
+// wide, so their nodes and the chunks touching them lie in the chunk's 26
+// neighbours. (The plain-cell shortcut looks one chunk further, but only
+// chooses between two ways to the same shape.)
+constexpr int kLevelReach = 1;
+constexpr int kLevelMapReach = 2;
 
 // The chunks contour_levels meshes: the world's and the layer below its box.
 bool chunk_is_meshable(const World& world, const glm::ivec3& chunk) {

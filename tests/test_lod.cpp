@@ -354,6 +354,38 @@ TEST(LodLevels, ChunkMeshesTogetherAreTheWholeMesh) {
   EXPECT_TRUE(got == expected);
 }
 
+// A chunk's mesh reads the levels and rays of its 26 neighbours only: other
+// levels beyond them, or a dig two chunks away, leave it as it was.
+TEST(LodLevels, AChunkMeshDependsOnlyOnItsNeighbours) {
+  const World w = spot_world(160);
+  auto base = [](const glm::ivec3& c) { return levels_test::scrambled_level(c, 3, 11); };
+  const glm::ivec3 centre = w.chunk_origin() + w.chunk_dims() / 2;
+  size_t meshed = 0;
+  w.for_each_chunk([&](const glm::ivec3& chunk, ChunkKind, const Chunk*) {
+    auto near_only = [&](const glm::ivec3& c) {
+      const glm::ivec3 d = glm::abs(c - chunk);
+      return std::max({d.x, d.y, d.z}) <= 1 ? base(c) : levels_test::scrambled_level(c, 3, 99);
+    };
+    const ChunkMesh a = contour_chunk_levels(w, chunk, base).value();
+    const ChunkMesh b = contour_chunk_levels(w, chunk, near_only).value();
+    EXPECT_EQ(a.mesh.positions, b.mesh.positions) << "chunk " << chunk.x << "," << chunk.y << "," << chunk.z;
+    EXPECT_EQ(a.mesh.triangles, b.mesh.triangles) << "chunk " << chunk.x << "," << chunk.y << "," << chunk.z;
+    meshed += a.mesh.triangle_count() > 0;
+  });
+  EXPECT_GT(meshed, 20u);
+  // Empty every chunk two or more away from the centre chunk: its mesh stays.
+  World cut = w;
+  cut.for_each_chunk([&](const glm::ivec3& c, ChunkKind, const Chunk*) {
+    const glm::ivec3 d = glm::abs(c - centre);
+    if (std::max({d.x, d.y, d.z}) >= 2) cut.set_uniform_chunk(c, false);
+  });
+  const ChunkMesh whole = contour_chunk_levels(w, centre, base).value();
+  const ChunkMesh alone = contour_chunk_levels(cut, centre, base).value();
+  EXPECT_GT(whole.mesh.triangle_count(), 0u);
+  EXPECT_EQ(whole.mesh.positions, alone.mesh.positions);
+  EXPECT_EQ(whole.mesh.triangles, alone.mesh.triangles);
+}
+
 TEST(LodLevels, AChunkOutsideTheMeshableBoxIsRefused) {
   const World w = spot_world(64);
   Result<ChunkMesh> r = contour_chunk_levels(w, w.chunk_origin() - 2, [](const glm::ivec3&) { return 0; });
