@@ -1,5 +1,7 @@
 // ldc contour (world or a region of a .ldcs store -> mesh) and ldc remesh (mesh -> LDC -> mesh).
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "cmd_store.h"
 #include "common.h"
@@ -18,7 +20,40 @@ struct ContourArgs {
   GridConfig grid;  // remesh only
   std::string region;  // contour of a .ldcs store only: X0,Y0,Z0,X1,Y1,Z1 (m)
   int lod = 0;         // contour only: every 2^lod-th ray (ldc/lod.h)
+  std::string lod_from;                 // contour only: X,Y,Z (m), with lod_bands
+  std::vector<double> lod_bands;        // contour only: level k from lod_bands[k - 1] m on
 };
+
+// --lod-from and --lod-bands: each chunk's level by its distance from a
+// point (lod_level, no hysteresis), set into args.level_of_chunk; the
+// chunks per level go to report["lod"].
+Status set_levels_by_distance(const ContourArgs& a, const World& w, MeshOutputArgs& mesh, nlohmann::json& report) {
+  if (a.lod_bands.empty() != a.lod_from.empty())
+    return Status(ErrorCode::kInvalidArgument, "--lod-from and --lod-bands go together: give both or neither");
+  if (a.lod_bands.empty()) return {};
+  if (a.lod > 0) return Status(ErrorCode::kInvalidArgument, "--lod and --lod-bands: give one or the other");
+  glm::dvec3 from;
+  if (!parse_vec3(a.lod_from, &from))
+    return Status(ErrorCode::kInvalidArgument, "--lod-from '" + a.lod_from + "': expected X,Y,Z (m), finite");
+  const LodBands bands{.start = a.lod_bands, .hysteresis = 0.0};
+  if (Status s = check_lod_bands(bands); !s.ok()) return Status(s.code(), "--lod-bands: " + s.message());
+  const int max_level = max_lod_level(w.chunk_size());
+  if (int(a.lod_bands.size()) > max_level) {
+    return Status(ErrorCode::kInvalidArgument, "--lod-bands: " + std::to_string(a.lod_bands.size()) +
+                                                   " bands ask for levels up to " + std::to_string(a.lod_bands.size()) +
+                                                   "; chunks of " + std::to_string(w.chunk_size()) +
+                                                   " cells allow up to " + std::to_string(max_level));
+  }
+  const Lattice lattice = w.lattice();
+  const int c = w.chunk_size();
+  mesh.level_of_chunk = [bands, lattice, c, from](const glm::ivec3& chunk) {
+    return lod_level(bands, chunk_distance(lattice, c, chunk, from), 0);
+  };
+  std::vector<size_t> per_level(a.lod_bands.size() + 1, 0);
+  w.for_each_chunk([&](const glm::ivec3& chunk, ChunkKind, const Chunk*) { ++per_level[size_t(mesh.level_of_chunk(chunk))]; });
+  report["lod"] = {{"from", {from.x, from.y, from.z}}, {"bands", a.lod_bands}, {"chunks_per_level", per_level}};
+  return {};
+}
 
 // The world at level `lod` (itself at 0); the seconds coarsening took go to
 // report["seconds"]["coarsen"].
@@ -84,9 +119,11 @@ int run_store_contour(const ContourArgs& a, const CommonOptions& common) {
   nlohmann::json report = {{"seconds", {{"page", page}, {"cut", c.seconds()}}},
                            {"region", range_json(layout, range.value())},
                            {"chunks_paged", paged.stats().page_ins}};
+  MeshOutputArgs mesh = a.mesh;
+  if (Status s = set_levels_by_distance(a, w.value(), mesh, report); !s.ok()) return fail("contour", s);
   w = at_level(std::move(w).value(), a.lod, report);
   if (!w.ok()) return fail("contour", w.status());
-  return contour_and_report("contour", w.value(), a.mesh, bar, std::move(report), common,
+  return contour_and_report("contour", w.value(), mesh, bar, std::move(report), common,
                             [](const nlohmann::json& r) {
                               std::printf("  region %s, %zu chunks paged\n", range_text(r["region"]).c_str(),
                                           r["chunks_paged"].get<size_t>());
@@ -104,9 +141,17 @@ int run_contour(const ContourArgs& a, const CommonOptions& common) {
   Result<World> w = load_world(a.input, {}, bar.context());
   if (!w.ok()) return fail("contour", w.status());
   nlohmann::json report = {{"seconds", {{"load", t.seconds()}}}};
+  MeshOutputArgs mesh = a.mesh;
+  if (Status s = set_levels_by_distance(a, w.value(), mesh, report); !s.ok()) return fail("contour", s);
   w = at_level(std::move(w).value(), a.lod, report);
   if (!w.ok()) return fail("contour", w.status());
-  return contour_and_report("contour", w.value(), a.mesh, bar, std::move(report), common);
+  return contour_and_report("contour", w.value(), mesh, bar, std::move(report), common,
+                            [](const nlohmann::json& r) {
+                              if (!r.contains("lod") || !r["lod"].contains("chunks_per_level")) return;
+                              std::string per;
+                              for (const auto& n : r["lod"]["chunks_per_level"]) per += (per.empty() ? "" : " / ") + n.dump();
+                              std::printf("  levels of detail by distance: chunks at level 0 / 1 / ... = %s\n", per.c_str());
+                            });
 }
 
 int run_remesh(const ContourArgs& a, const CommonOptions& common) {
@@ -142,6 +187,13 @@ void add_contour_commands(CLI::App& app, CommonOptions& common) {
                       "for chunks of 16, 32, 64 cells)")
       ->check(CLI::Range(0, 3))
       ->capture_default_str();
+  contour->add_option("--lod-from", c->lod_from,
+                      "X,Y,Z (m): mesh each chunk at a level by its distance from this point (with --lod-bands); "
+                      "the seams between levels are closed");
+  contour->add_option("--lod-bands", c->lod_bands,
+                      "D1[,D2[,D3]] (m, increasing): chunks from D1 on at level 1, from D2 on at level 2, ... "
+                      "(with --lod-from)")
+      ->delimiter(',');
   contour->callback([c, &common] {
     int code = run_contour(*c, common);
     if (code != 0) throw CLI::RuntimeError(code);

@@ -10,6 +10,9 @@ namespace ldc::tool {
 namespace {
 
 Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats* stats) {
+  if (a.method == "mc" && a.level_of_chunk) {
+    return Status(ErrorCode::kInvalidArgument, "--method mc has no levels of detail: leave out --lod-bands");
+  }
   if (a.method == "mc") return marching_cubes(w, ctx);
   ContourConfig c = a.config;
   if (a.method == "iterative") c.placement = Placement::kIterative;
@@ -22,6 +25,7 @@ Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, Context*
   // blunts sharp features (fandisk's Hausdorff error 4x larger) and triples
   // the contouring time.
   c.untangle = false;
+  if (a.level_of_chunk) return contour_levels(w, a.level_of_chunk, c, ctx, stats);
   return contour_world(w, c, ctx, stats);
 }
 

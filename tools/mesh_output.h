@@ -26,6 +26,8 @@ struct MeshOutputArgs {
   // before add_mesh_output_options.
   double max_error_cells = 0.0;
   size_t target_triangles = 0;
+  // Set: each chunk meshed at its own level (contour_levels), not with `method`'s placement only.
+  std::function<int(const glm::ivec3&)> level_of_chunk;
 };
 
 // -o and the contouring options: --method, --iterations, --relax, --slack,
