@@ -292,5 +292,88 @@ TEST(RenderGiImage, SideBySidePutsTheRightImageAfterEachRow) {
   EXPECT_FALSE(side_by_side(a, pattern(2, 3)).ok());
 }
 
+// --- render_mesh -------------------------------------------------------------------
+
+namespace mesh_image {
+
+// The unit cube [0, 1]^3, 12 triangles counter-clockwise seen from outside.
+TriangleMesh cube() {
+  TriangleMesh m;
+  for (int c = 0; c < 8; ++c) m.positions.emplace_back(c & 1, (c >> 1) & 1, (c >> 2) & 1);
+  const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+  for (const auto& f : faces) {
+    m.triangles.emplace_back(f[0], f[1], f[2]);
+    m.triangles.emplace_back(f[0], f[2], f[3]);
+  }
+  return m;
+}
+
+Camera looking_at_cube_from(const glm::dvec3& position) {
+  CameraConfig c;
+  c.position = position;
+  c.target = glm::dvec3(0.5);
+  c.width = 64;
+  c.height = 64;
+  return Camera::make(c).value();
+}
+
+glm::ivec3 pixel(const Image& img, int x, int y) {
+  const uint8_t* p = &img.rgb[3 * (size_t(y) * size_t(img.width) + size_t(x))];
+  return {p[0], p[1], p[2]};
+}
+
+glm::ivec3 background_pixel(const MeshRenderOptions& o) {
+  return glm::ivec3(glm::round(glm::clamp(o.background, 0.0, 1.0) * 255.0));
+}
+
+}  // namespace mesh_image
+
+TEST(RenderMesh, ACubeCoversTheCentreAndLeavesTheCornersAndItsEdgesAreDarkened) {
+  const MeshRenderOptions o;
+  const Image img = render_mesh(mesh_image::cube(), mesh_image::looking_at_cube_from({0.5, -3.0, 0.5}), o).value();
+  ASSERT_EQ(img.width, 64);
+  EXPECT_NE(mesh_image::pixel(img, 32, 32), mesh_image::background_pixel(o));
+  EXPECT_EQ(mesh_image::pixel(img, 1, 1), mesh_image::background_pixel(o));
+  // The face's diagonal (an edge between its two triangles) is darker than the face beside it.
+  const glm::ivec3 face = mesh_image::pixel(img, 26, 32), diagonal = mesh_image::pixel(img, 31, 32);  // x + y = 64
+  EXPECT_LT(diagonal.x + diagonal.y + diagonal.z, face.x + face.y + face.z);
+}
+
+TEST(RenderMesh, ACrackShowsTheBackgroundThroughIt) {
+  TriangleMesh open = mesh_image::cube();
+  open.triangles.erase(open.triangles.begin() + 4, open.triangles.begin() + 6);  // the y = 0 face, seen by the camera
+  const MeshRenderOptions o;
+  const Image img = render_mesh(open, mesh_image::looking_at_cube_from({0.5, -3.0, 0.5}), o).value();
+  EXPECT_EQ(mesh_image::pixel(img, 26, 34), mesh_image::background_pixel(o));
+}
+
+TEST(RenderMesh, ATriangleReachingBehindTheCameraIsClippedNotDropped) {
+  TriangleMesh ground;
+  ground.positions = {{-100.0, -100.0, 0.0}, {100.0, -100.0, 0.0}, {0.0, 100.0, 0.0}};
+  ground.triangles = {{0, 1, 2}};
+  CameraConfig c;
+  c.position = glm::dvec3(0.0, -50.0, 2.0);
+  c.target = glm::dvec3(0.0, 0.0, 0.0);
+  c.width = 32;
+  c.height = 32;
+  const MeshRenderOptions o;
+  const Image img = render_mesh(ground, Camera::make(c).value(), o).value();
+  EXPECT_NE(mesh_image::pixel(img, 16, 31), mesh_image::background_pixel(o));  // the ground just below the camera
+}
+
+TEST(RenderMesh, BadIndicesAndColourCountsAreRefused) {
+  TriangleMesh bad = mesh_image::cube();
+  bad.triangles.push_back({0, 1, 8});
+  const Camera cam = mesh_image::looking_at_cube_from({0.5, -3.0, 0.5});
+  Result<Image> r = render_mesh(bad, cam);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("indexes past the 8 vertices"), std::string::npos) << r.status().message();
+  MeshRenderOptions o;
+  o.triangle_colour.assign(3, glm::vec3(1.0f));
+  r = render_mesh(mesh_image::cube(), cam, o);
+  ASSERT_FALSE(r.ok());
+  EXPECT_NE(r.status().message().find("3 entries for 12 triangles"), std::string::npos) << r.status().message();
+}
+
 }  // namespace
 }  // namespace ldc
