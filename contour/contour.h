@@ -291,9 +291,9 @@ Result<ContourMesh> contour_levels(const World& world, const std::function<int(c
 // depends only on the rays and the levels of the chunk and its 26
 // neighbours (everything it meshes lies within two cells of it, and a cell
 // is at most C / 8 wide), so when a chunk changes level or its rays change,
-// re-mesh it and its 26 neighbours. Where those neighbours leave the world's
-// box, the box faces must be outside (check_box_faces_outside; a window cut
-// through the ground is refused there).
+// re-mesh it and its 26 neighbours. The box faces it reaches (within C / 4
+// of the chunk) must be outside (check_box_faces_outside over that range: a
+// chunk beside a window's face cut through the ground is refused).
 // `chunk` may be any chunk of the box or of the layer below it
 // (kInvalidArgument otherwise). Thread-safe as contour_chunk.
 Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chunk,

@@ -122,11 +122,23 @@ Cell cell_at_doubled(const LevelMap& levels, const glm::ivec3& doubled) {
 class LevelReader {
  public:
   LevelReader(const World* world, int highest_level) : world_(world), highest_(highest_level) {}
+  // Reads another world (or the same after a change) next: forgets what was
+  // loaded, keeping the regions' buffers.
+  void rebind(const World* world, int highest_level) {
+    world_ = world;
+    highest_ = highest_level;
+    forget();
+    focus_level_ = -1;
+  }
 
   // Loads chunk `chunk` of the level-`level` world as the region looked at
-  // first (the chunk being meshed), kept apart from the recently used ones.
+  // first (the chunk being meshed). Other chunks' regions are then read
+  // only near it (what meshing it reads: within C / 4 + 1 nodes of its box),
+  // and whole where a read falls beyond that.
   const Region& focus(int level, const glm::ivec3& chunk) {
-    load(focus_, level, chunk);
+    forget();  // the near parts were cut for the last focus
+    focus_level_ = -1;
+    load(focus_, level, chunk, false);
     focus_level_ = level;
     focus_lo_ = chunk * world_->chunk_size();
     focus_hi_ = focus_lo_ + world_->chunk_size();
@@ -138,24 +150,54 @@ class LevelReader {
     const unsigned bits = unsigned(node.x) | unsigned(node.y) | unsigned(node.z);
     const int m = std::min(std::countr_zero(bits), highest_);
     const glm::ivec3 at = node >> m;
-    return region(m, at >> chunk_shift(m)).inside(at);
+    return holding(m, at, at).inside(at);
   }
   // The crossing of the edge from `lower` along `axis`, 2^level long.
   const EdgeCrossing* crossing(const glm::ivec3& lower, int axis, int level) {
     if (level == focus_level_ && in_focus(lower) && lower[axis] < focus_hi_[axis])
       return focus_.crossing(axis, lower >> level);
     const glm::ivec3 at = lower >> level;
-    return region(level, at >> chunk_shift(level)).crossing(axis, at);
+    return holding(level, at, at + unit(axis)).crossing(axis, at);
   }
-  // Nodes [c C_m, (c + 1) C_m] of the level-m world (its chunk c, closed).
-  const Region& region(int level, const glm::ivec3& chunk) {
+
+ private:
+  static constexpr size_t kSlots = 32;
+  struct Slot {
+    int level;
+    glm::ivec3 chunk;
+    bool near;  // only the part near the focus
+    uint64_t used;
+    std::unique_ptr<Region> region;
+  };
+
+  void forget() {
+    for (Slot& s : slots_) s.level = -1;
+  }
+  bool in_focus(const glm::ivec3& node) const {
+    const unsigned mask = (1u << focus_level_) - 1u;
+    return focus_level_ >= 0 && ((unsigned(node.x) | unsigned(node.y) | unsigned(node.z)) & mask) == 0 &&
+           glm::all(glm::greaterThanEqual(node, focus_lo_)) && glm::all(glm::lessThanEqual(node, focus_hi_));
+  }
+  int chunk_shift(int level) const { return world_->chunk_shift() - level; }
+
+  // A region of the level-m world holding its nodes a and b, of the chunk
+  // holding a: the part near the focus when it holds both, else the whole chunk.
+  const Region& holding(int level, const glm::ivec3& a, const glm::ivec3& b) {
+    const glm::ivec3 chunk = a >> chunk_shift(level);
+    const Region& near = region(level, chunk, true);
+    if (near.contains(a) && near.contains(b)) return near;
+    return region(level, chunk, false);
+  }
+
+  const Region& region(int level, const glm::ivec3& chunk, bool near) {
     ++clock_;
-    if (last_ < slots_.size() && slots_[last_].level == level && slots_[last_].chunk == chunk) {
+    auto is = [&](const Slot& s) { return s.level == level && s.near == near && s.chunk == chunk; };
+    if (last_ < slots_.size() && is(slots_[last_])) {
       slots_[last_].used = clock_;
       return *slots_[last_].region;
     }
     for (Slot& s : slots_) {
-      if (s.level == level && s.chunk == chunk) {
+      if (is(s)) {
         s.used = clock_;
         last_ = size_t(&s - slots_.data());
         return *s.region;
@@ -163,36 +205,32 @@ class LevelReader {
     }
     Slot* slot = nullptr;
     if (slots_.size() < kSlots) {
-      slots_.push_back({level, chunk, clock_, std::make_unique<Region>()});
+      slots_.push_back({level, chunk, near, clock_, std::make_unique<Region>()});
       slot = &slots_.back();
     } else {
       slot = &*std::min_element(slots_.begin(), slots_.end(),
                                 [](const Slot& a, const Slot& b) { return a.used < b.used; });
-      *slot = {level, chunk, clock_, std::move(slot->region)};
+      *slot = {level, chunk, near, clock_, std::move(slot->region)};
     }
-    load(*slot->region, level, chunk);
+    load(*slot->region, level, chunk, near);
     last_ = size_t(slot - slots_.data());
     return *slot->region;
   }
 
- private:
-  bool in_focus(const glm::ivec3& node) const {
-    const unsigned mask = (1u << focus_level_) - 1u;
-    return focus_level_ >= 0 && ((unsigned(node.x) | unsigned(node.y) | unsigned(node.z)) & mask) == 0 &&
-           glm::all(glm::greaterThanEqual(node, focus_lo_)) && glm::all(glm::lessThanEqual(node, focus_hi_));
-  }
-  static constexpr size_t kSlots = 32;
-  struct Slot {
-    int level;
-    glm::ivec3 chunk;
-    uint64_t used;
-    std::unique_ptr<Region> region;
-  };
-  int chunk_shift(int level) const { return world_->chunk_shift() - level; }
-  void load(Region& region, int level, const glm::ivec3& chunk) const {
+  // Nodes [c C_m, (c + 1) C_m] of the level-m world (its chunk c, closed);
+  // with `near`, only those within C / 4 + 1 level-0 nodes of the focus.
+  void load(Region& region, int level, const glm::ivec3& chunk, bool near) const {
     const int c = world_->chunk_size() >> level;
-    region.load(*world_, chunk * c, chunk * c + c + 1, chunk * c, chunk * c, 1 << level);
+    glm::ivec3 lo = chunk * c, hi = chunk * c + c + 1;
+    if (near && focus_level_ >= 0) {
+      const int reach = world_->chunk_size() / 4 + 1;
+      const glm::ivec3 near_lo = glm::max(lo, (focus_lo_ - reach) >> level);
+      const glm::ivec3 near_hi = glm::min(hi, ((focus_hi_ + reach) >> level) + 1);
+      if (glm::all(glm::lessThan(near_lo, near_hi))) lo = near_lo, hi = near_hi;
+    }
+    region.load(*world_, lo, hi, lo, lo, 1 << level);
   }
+
   const World* world_;
   int highest_;
   std::vector<Slot> slots_;
@@ -483,6 +521,13 @@ class ChunkMesher {
  public:
   ChunkMesher(const LevelMap* levels, const World* world, const ContourConfig* config)
       : levels_(levels), reader_(world, levels->highest()), chunk_size_(world->chunk_size()), config_(config) {}
+  // Meshes with other levels, world or config next, keeping the buffers.
+  void rebind(const LevelMap* levels, const World* world, const ContourConfig* config) {
+    levels_ = levels;
+    reader_.rebind(world, levels->highest());
+    chunk_size_ = world->chunk_size();
+    config_ = config;
+  }
 
   void mesh(const glm::ivec3& chunk, ChunkPart& out) {
     out = ChunkPart();
@@ -804,18 +849,12 @@ ContourMesh assemble(const World& world, const std::vector<ChunkPart>& parts,
 // wide, so their nodes and the chunks touching them lie in the chunk's 26
 // neighbours. (The plain-cell shortcut looks one chunk further, but only
 // chooses between two ways to the same shape.)
-constexpr int kLevelReach = 1;
 constexpr int kLevelMapReach = 2;
 
 // The chunks contour_levels meshes: the world's and the layer below its box.
 bool chunk_is_meshable(const World& world, const glm::ivec3& chunk) {
   const glm::ivec3 lo = world.chunk_origin() - 1, hi = world.chunk_origin() + world.chunk_dims();
   return glm::all(glm::greaterThanEqual(chunk, lo)) && glm::all(glm::lessThan(chunk, hi));
-}
-
-bool reach_in_box(const World& world, const glm::ivec3& chunk, int reach) {
-  const glm::ivec3 lo = world.chunk_origin(), hi = world.chunk_origin() + world.chunk_dims();
-  return glm::all(glm::greaterThanEqual(chunk - reach, lo)) && glm::all(glm::lessThan(chunk + reach, hi));
 }
 
 Result<ContourMesh> mesh_levels(const World& world, const LevelMap& levels, const ContourConfig& config,
@@ -900,14 +939,19 @@ Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chu
                                                    std::to_string(chunk.y) + ", " + std::to_string(chunk.z) +
                                                    ") is outside the world's box and the layer below it");
   }
-  if (!reach_in_box(world, chunk, kLevelReach)) {
-    if (s = check_box_faces_outside(world); !s.ok()) return s;
-  }
+  // What the chunk's mesh reads lies within two of its cells (at most C / 4) of it.
+  const int c = world.chunk_size(), reach = c / 4 + 1;
+  if (s = check_box_faces_outside(world, chunk * c - reach, (chunk + 1) * c + reach + 1); !s.ok()) return s;
   try {
     ScopedTimer timer(nullptr, "contour_chunk_levels");
     LevelMap levels;
     if (s = levels.build(world, level_of_chunk, chunk - kLevelMapReach, chunk + kLevelMapReach + 1); !s.ok()) return s;
-    ChunkMesher mesher(&levels, &world, &config);
+    // One mesher per thread, kept between calls: its regions' buffers are
+    // allocated once (allocating them was most of a small chunk's cost).
+    thread_local std::unique_ptr<ChunkMesher> kept;
+    if (kept) kept->rebind(&levels, &world, &config);
+    else kept = std::make_unique<ChunkMesher>(&levels, &world, &config);
+    ChunkMesher& mesher = *kept;
     ChunkPart own;
     mesher.mesh(chunk, own);
     ChunkAndNeighbours lookup(mesher, levels, own, chunk, world.chunk_size());

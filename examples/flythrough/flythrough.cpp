@@ -14,18 +14,21 @@
 //   3. save    right after, the edits are saved incrementally: appended to a
 //              crash-safe chunk log (ChunkLog::commit) and laid over the
 //              generator (OverlaySource), so they survive eviction;
-//   4. mesh    a mesh worker thread meshes the chunks that came into view
-//              or were edited (contour_chunk), nearest first; the frame
-//              collects what it finished and drops meshes of chunks that
-//              left the window;
+//   4. mesh    each chunk has a level of detail by its distance to the
+//              camera (lod_level, with hysteresis: level 1 from 12 m,
+//              level 2 from 24 m); a mesh worker thread meshes, nearest
+//              first, the chunks that came into view, were edited, or have a
+//              neighbour whose level changed (contour_chunk_levels: seams
+//              between levels closed); the frame collects what it finished
+//              and drops meshes of chunks that left the window;
 //   5. ray     a ground ray is cast under the camera (Queries);
 //   6. nav     a nav worker thread rebuilds the nav mesh of the window
 //              around the player when it has moved 8 m or dug, and plans a
 //              path 12 m ahead on it.
-// Not done here yet: LOD meshes (every chunk is meshed at full resolution).
 // It prints the median, p95 and max of each stage and of the frame, the
 // peak resident memory, the pager's and the log's figures, and with --png
-// renders a few frames (render/render.h).
+// renders a few frames (render/render.h): the world ray-traced, and the
+// chunk meshes drawn as they are (render_mesh), tinted by level.
 //
 // Usage: flythrough [--frames N] [--budget-mb M] [--size-km K] [--speed V]
 //                   [--store PATH] [--png DIR] [--quiet]
@@ -43,6 +46,7 @@
 #include <map>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <string>
 #include <thread>
 #include <utility>
@@ -51,6 +55,7 @@
 #include "contour/contour.h"
 #include "csg/csg.h"
 #include "ldc/chunk_log.h"
+#include "ldc/lod.h"
 #include "ldc/query.h"
 #include "ldc/store.h"
 #include "ldc/terrain.h"
@@ -121,6 +126,19 @@ constexpr int kFps = 60;
 constexpr double kViewRadius = 40.0;  // m: the window around the camera
 constexpr double kNavRadius = 20.0;   // m: the window the nav mesh covers
 constexpr double kNavRebuildDistance = 8.0;  // m
+// Chunk levels by distance from the camera: 1 from 12 m, 2 from 24 m.
+const ldc::LodBands kLodBands{.start = {12.0, 24.0}, .hysteresis = 1.5};
+
+using ChunkKey = std::tuple<int, int, int>;
+using LevelMap = std::map<ChunkKey, int>;
+
+ChunkKey key(const glm::ivec3& c) { return {c.x, c.y, c.z}; }
+
+// A chunk mesh and the level it was meshed at.
+struct LevelMesh {
+  ldc::ChunkMesh mesh;
+  int level = 0;
+};
 
 // One frame's measurements [ms].
 struct Frame {
@@ -242,39 +260,69 @@ class NavWorker {
   LatestJobWorker<NavJob> worker_;
 };
 
+// A level map as the frame hands it out: shared, never changed, and named
+// by an id that the meshes made from it carry back.
+struct Levels {
+  uint64_t id = 0;
+  LevelMap map;  // every chunk of the window
+  int at(const glm::ivec3& c) const {
+    auto it = map.find(key(c));
+    return it == map.end() ? 0 : it->second;
+  }
+};
+using LevelsPtr = std::shared_ptr<const Levels>;
+
+struct MeshJob {
+  glm::ivec3 chunk;
+  LevelsPtr levels;
+};
+
+// A chunk mesh, its level, and the id of the level map it was made from.
+struct MadeMesh {
+  LevelMesh mesh;
+  uint64_t levels_id = 0;
+};
+
 // Meshes chunks on its own thread, as an engine's job system would: the
 // frame hands it the current window (a snapshot: chunks are shared) and the
-// chunks to mesh, nearest first, and collects finished meshes next frame.
+// jobs (a chunk and the level map to mesh it from), nearest first, and
+// collects finished meshes next frame.
 class MeshWorker {
  public:
-  explicit MeshWorker(const ldc::ContourConfig& config) : config_(config), thread_([this] { loop(); }) {}
+  // `threads` meshing threads share the queue (contour_chunk_levels may run concurrently).
+  MeshWorker(const ldc::ContourConfig& config, int threads) : config_(config) {
+    for (int i = 0; i < threads; ++i) threads_.emplace_back([this] { loop(); });
+  }
   ~MeshWorker() {
     {
       std::lock_guard lock(mutex_);
       stop_ = true;
     }
-    wake_.notify_one();
-    thread_.join();
+    wake_.notify_all();
+    for (std::thread& t : threads_) t.join();
   }
-  // Replaces the queue: these chunks of this window, in this order.
-  void request(const ldc::World& window, std::vector<glm::ivec3> chunks) {
+  // Replaces the queue: these jobs on this window, in this order.
+  void request(const ldc::World& window, std::vector<MeshJob> jobs) {
     {
       std::lock_guard lock(mutex_);
       window_ = std::make_shared<const ldc::World>(window);
-      queue_ = std::move(chunks);
+      queue_ = std::move(jobs);
     }
-    wake_.notify_one();
+    wake_.notify_all();
   }
   // The meshes finished since the last call.
-  std::vector<ldc::ChunkMesh> take() {
+  std::vector<MadeMesh> take() {
     std::lock_guard lock(mutex_);
     return std::exchange(done_, {});
   }
   size_t queued() {
     std::lock_guard lock(mutex_);
-    return queue_.size();
+    return queue_.size() + running_;
   }
-  double busy_ms() const { return busy_ms_.load(); }
+  double busy_ms() {
+    std::lock_guard lock(mutex_);
+    return busy_ms_;
+  }
 
  private:
   void loop() {
@@ -282,16 +330,21 @@ class MeshWorker {
     while (true) {
       wake_.wait(lock, [this] { return stop_ || !queue_.empty(); });
       if (stop_) return;
-      const glm::ivec3 chunk = queue_.front();
+      const MeshJob job = queue_.front();
       queue_.erase(queue_.begin());
       std::shared_ptr<const ldc::World> window = window_;
+      ++running_;
       lock.unlock();
       const Clock::time_point start = Clock::now();
-      Result<ldc::ChunkMesh> m = ldc::contour_chunk(*window, chunk, config_);
-      busy_ms_ = busy_ms_.load() + ms_since(start);
+      // Every chunk of the window has a level; the mesher asks only for those.
+      auto level_of = [&](const glm::ivec3& c) { return job.levels->at(c); };
+      Result<ldc::ChunkMesh> m = ldc::contour_chunk_levels(*window, job.chunk, level_of, config_);
+      const double took = ms_since(start);
       lock.lock();
+      --running_;
+      busy_ms_ += took;
       if (m.ok()) {
-        done_.push_back(std::move(m).value());
+        done_.push_back({{std::move(m).value(), level_of(job.chunk)}, job.levels->id});
       } else {
         std::fprintf(stderr, "mesh: %s\n", m.status().to_string().c_str());
       }
@@ -302,11 +355,12 @@ class MeshWorker {
   std::mutex mutex_;
   std::condition_variable wake_;
   std::shared_ptr<const ldc::World> window_;
-  std::vector<glm::ivec3> queue_;
-  std::vector<ldc::ChunkMesh> done_;
-  std::atomic<double> busy_ms_{0.0};
+  std::vector<MeshJob> queue_;
+  std::vector<MadeMesh> done_;
+  int running_ = 0;
+  double busy_ms_ = 0.0;  // over all threads
   bool stop_ = false;
-  std::thread thread_;
+  std::vector<std::thread> threads_;
 };
 
 // The chunk box of the window of `radius` m around a ground point.
@@ -318,6 +372,18 @@ void chunk_box(const ldc::SourceLayout& layout, const glm::dvec2& xy, double rad
   *hi = glm::ivec3(glm::floor((xy + radius - o) / c) + 1.0, layout.box.chunk_origin.z + layout.box.chunk_dims.z);
 }
 
+// Changes to meshes already shown (a chunk's level, a dig) are made as one
+// batch: its chunks are meshed from one level map and shown together when
+// the last is done, so that a shown chunk mesh never meets a neighbour's
+// made from other levels or other rays (no crack while the worker catches
+// up). One batch at a time: level changes wait for it; a dig joins it.
+struct Batch {
+  LevelsPtr levels;                       // what its chunks are meshed from
+  std::set<ChunkKey> chunks;              // to show together
+  std::map<ChunkKey, LevelMesh> staged;   // made, not yet shown
+  std::set<ChunkKey> changed;             // chunks whose level or rays changed
+};
+
 struct Session {
   std::shared_ptr<ldc::OverlaySource> overlay;
   std::unique_ptr<ldc::PagedWorld> paged;
@@ -325,20 +391,108 @@ struct Session {
   ldc::World window;
   glm::ivec3 window_lo{0}, window_hi{0};
   bool window_stale = true;
-  std::map<std::tuple<int, int, int>, ldc::ChunkMesh> meshes;
-  std::vector<glm::ivec3> remesh;  // chunks to (re)mesh, nearest first
+  std::map<ChunkKey, LevelMesh> meshes;  // shown
+  LevelsPtr levels = std::make_shared<const Levels>();  // the shown meshes' levels
+  uint64_t next_levels_id = 1;
+  std::optional<Batch> batch;
+  std::set<ChunkKey> fresh;  // chunks come into view, to mesh from the shown levels and show when made
+  bool queue_stale = true;   // the worker's queue is to be handed out again
+  size_t level_changes = 0, batches = 0;
   size_t triangles = 0, meshed = 0, digs = 0, saved_chunks = 0;
   std::optional<double> ground_z;
   std::optional<glm::dvec2> nav_centre;  // where the nav worker's last window is centred
 };
 
-std::tuple<int, int, int> key(const glm::ivec3& c) { return {c.x, c.y, c.z}; }
+glm::ivec3 chunk_of(const ChunkKey& k) { return {std::get<0>(k), std::get<1>(k), std::get<2>(k)}; }
 
-// Chunks whose neighbours are all in the window: their meshes are whole.
+// Chunks whose neighbours across the window's sides are in the window: their
+// meshes are whole. The window spans the world's height, whose faces are in
+// the air and under the ground's floor (outside), so every layer is meshed.
 bool meshable(const Session& s, const glm::ivec3& c, const ldc::SourceLayout& layout) {
-  const glm::ivec3 lo = glm::max(s.window_lo + 1, layout.box.chunk_origin);
-  const glm::ivec3 hi = glm::min(s.window_hi - 1, layout.box.chunk_origin + layout.box.chunk_dims);
+  glm::ivec3 lo = glm::max(s.window_lo + 1, layout.box.chunk_origin);
+  glm::ivec3 hi = glm::min(s.window_hi - 1, layout.box.chunk_origin + layout.box.chunk_dims);
+  lo.z = s.window_lo.z;
+  hi.z = s.window_hi.z;
   return glm::all(glm::greaterThanEqual(c, lo)) && glm::all(glm::lessThan(c, hi));
+}
+
+// Whether a chunk and its 26 neighbours are all air or all solid: no surface
+// passes through it, so it has no mesh to make.
+bool quiet(const ldc::World& window, const glm::ivec3& c) {
+  const ldc::ChunkKind kind = window.chunk_kind(c);
+  if (kind == ldc::ChunkKind::kMixed) return false;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (window.chunk_kind(c + glm::ivec3(dx, dy, dz)) != kind) return false;
+  return true;
+}
+
+bool wants_mesh(const Session& s, const glm::ivec3& c) {
+  return meshable(s, c, s.paged->layout()) && !quiet(s.window, c);
+}
+
+// Whether c is within one chunk of a chunk the batch changed: a chunk's mesh
+// reads the rays and levels of its 26 neighbours (contour_chunk_levels).
+bool near_change(const Batch& b, const glm::ivec3& c) {
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (b.changed.count(key(c + glm::ivec3(dx, dy, dz)))) return true;
+  return false;
+}
+
+// Adds chunk c's change to the batch (starting one from `levels` if none):
+// c and its neighbours are meshed again.
+void add_change(Session& s, const glm::ivec3& c, const LevelsPtr& levels) {
+  if (!s.batch) s.batch = Batch{levels, {}, {}, {}};
+  s.batch->changed.insert(key(c));
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
+        if (!wants_mesh(s, n)) continue;
+        s.batch->chunks.insert(key(n));
+        s.batch->staged.erase(key(n));  // made before this change
+      }
+  s.queue_stale = true;
+}
+
+// The level of a chunk at distance d, its level before being `previous`.
+int level_at(double d, const std::optional<int>& previous) { return ldc::lod_level(kLodBands, d, previous.value_or(0)); }
+
+// The window's chunks' levels by distance to the camera, with hysteresis.
+// When no batch is under way and some chunk's level changed, starts one
+// with the new levels. New window chunks get their level in the shown map
+// (and the batch's): no shown mesh reads them yet.
+void set_levels(Session& s, const glm::dvec3& camera) {
+  const ldc::SourceLayout& layout = s.paged->layout();
+  auto with_new_chunks = [&](const LevelsPtr& from) {
+    auto next = std::make_shared<Levels>(*from);
+    s.window.for_each_chunk([&](const glm::ivec3& c, ldc::ChunkKind, const ldc::Chunk*) {
+      if (!next->map.count(key(c)))
+        next->map[key(c)] = level_at(ldc::chunk_distance(layout.lattice, layout.chunk_size, c, camera), std::nullopt);
+    });
+    return LevelsPtr(std::move(next));
+  };
+  s.levels = with_new_chunks(s.levels);
+  if (s.batch) {
+    s.batch->levels = with_new_chunks(s.batch->levels);
+    return;
+  }
+  auto next = std::make_shared<Levels>(*s.levels);
+  next->id = s.next_levels_id++;
+  std::vector<glm::ivec3> changed;
+  for (auto& [k, level] : next->map) {
+    const glm::ivec3 c = chunk_of(k);
+    const int now = level_at(ldc::chunk_distance(layout.lattice, layout.chunk_size, c, camera), level);
+    if (now != level) changed.push_back(c);
+    level = now;
+  }
+  if (changed.empty()) return;
+  const LevelsPtr levels(std::move(next));
+  for (const glm::ivec3& c : changed) add_change(s, c, levels);
+  s.level_changes += changed.size();
 }
 
 // Sets *changed when the frame's window is a new one.
@@ -356,23 +510,25 @@ Status page(Session& s, Prefetcher& prefetcher, const ldc::SourceLayout& layout,
   s.window_lo = s.window.chunk_origin();
   s.window_hi = s.window_lo + s.window.chunk_dims();
   s.window_stale = false;
-  // Drop meshes that left the window; queue the chunks that came in.
-  for (auto it = s.meshes.begin(); it != s.meshes.end();) {
-    const glm::ivec3 c(std::get<0>(it->first), std::get<1>(it->first), std::get<2>(it->first));
-    it = meshable(s, c, layout) ? std::next(it) : s.meshes.erase(it);
+  // Drop what left the window; the chunks that came in are meshed fresh (and
+  // join the batch under way where a change is beside them).
+  auto gone = [&](const ChunkKey& k) { return !meshable(s, chunk_of(k), layout); };
+  std::erase_if(s.meshes, [&](const auto& e) { return gone(e.first); });
+  std::erase_if(s.fresh, gone);
+  if (s.batch) {
+    std::erase_if(s.batch->chunks, gone);
+    std::erase_if(s.batch->staged, [&](const auto& e) { return gone(e.first); });
   }
-  s.remesh.erase(std::remove_if(s.remesh.begin(), s.remesh.end(),
-                                [&](const glm::ivec3& c) { return !meshable(s, c, layout); }),
-                 s.remesh.end());
   s.window.for_each_chunk([&](const glm::ivec3& c, ldc::ChunkKind, const ldc::Chunk*) {
-    if (meshable(s, c, layout) && !s.meshes.count(key(c)) &&
-        std::find(s.remesh.begin(), s.remesh.end(), c) == s.remesh.end())
-      s.remesh.push_back(c);
+    if (s.meshes.count(key(c)) || !wants_mesh(s, c)) return;
+    s.fresh.insert(key(c));
+    if (s.batch && near_change(*s.batch, c)) s.batch->chunks.insert(key(c));
   });
+  s.queue_stale = true;
   return {};
 }
 
-Status dig(Session& s, const glm::dvec2& xy, const ldc::ContourConfig& config) {
+Status dig(Session& s, const glm::dvec2& xy) {
   if (!s.ground_z) return {};
   ldc::WorldEditor editor(s.window);
   Result<ldc::EditReceipt> r = editor.apply(ldc::Brush::sphere({xy.x, xy.y, *s.ground_z}, 2.0), ldc::EditOp::kSubtract);
@@ -382,10 +538,14 @@ Status dig(Session& s, const glm::dvec2& xy, const ldc::ContourConfig& config) {
   for (const ldc::DirtyChunk& d : dirty) chunks.push_back(d.chunk);
   s.window = editor.world();
   if (Status p = s.paged->put(s.window, chunks); !p.ok()) return p;
-  for (const glm::ivec3& c : ldc::chunks_a_remesh_may_change(dirty, config, s.window.chunk_size())) {
-    if (meshable(s, c, s.paged->layout()) && std::find(s.remesh.begin(), s.remesh.end(), c) == s.remesh.end())
-      s.remesh.push_back(c);
+  LevelsPtr levels = s.levels;
+  if (!s.batch) {  // the shown levels, under a new id: meshes made before the dig are not the batch's
+    auto copy = std::make_shared<Levels>(*s.levels);
+    copy->id = s.next_levels_id++;
+    levels = std::move(copy);
   }
+  for (const glm::ivec3& c : chunks) add_change(s, c, levels);
+  // Fresh chunks beside the dig are meshed from the new rays: drop what was made before.
   ++s.digs;
   return {};
 }
@@ -402,26 +562,62 @@ Status save(Session& s) {
   return s.log->commit(chunks);
 }
 
-// Collects the meshes the worker finished (those still in view), then hands
-// it the chunks still to mesh, nearest first.
-void mesh(Session& s, MeshWorker& worker, const glm::dvec2& xy, bool window_changed) {
-  for (ldc::ChunkMesh& m : worker.take()) {
-    if (!meshable(s, m.chunk, s.paged->layout())) continue;
-    const glm::ivec3 chunk = m.chunk;
-    s.meshes[key(chunk)] = std::move(m);
-    s.remesh.erase(std::remove(s.remesh.begin(), s.remesh.end(), chunk), s.remesh.end());
-    ++s.meshed;
+// A finished mesh: shown (fresh, from the shown levels), staged (the
+// batch's), or, made from levels since replaced, meshed again if still wanted.
+void collect(Session& s, MadeMesh&& m) {
+  const glm::ivec3 c = m.mesh.mesh.chunk;
+  const ChunkKey k = key(c);
+  ++s.meshed;
+  if (s.batch && m.levels_id == s.batch->levels->id) {
+    if (s.batch->chunks.count(k)) s.batch->staged[k] = std::move(m.mesh);
+    return;
   }
-  if (window_changed && !s.remesh.empty()) {
+  if (m.levels_id == s.levels->id && s.fresh.count(k)) {
+    s.meshes[k] = std::move(m.mesh);
+    s.fresh.erase(k);
+    return;
+  }
+  s.queue_stale = true;  // stale: it is still in `fresh` or the batch, and will be asked for again
+}
+
+// Shows the batch when every chunk of it is made.
+void finish_batch(Session& s) {
+  if (!s.batch || s.batch->staged.size() < s.batch->chunks.size()) return;
+  for (auto& [k, m] : s.batch->staged) s.meshes[k] = std::move(m);
+  s.levels = s.batch->levels;
+  for (const ChunkKey& k : s.batch->chunks) s.fresh.erase(k);
+  s.batch.reset();
+  ++s.batches;
+  s.queue_stale = true;  // fresh chunks made from the old levels are made again
+}
+
+size_t waiting(const Session& s) {
+  return s.fresh.size() + (s.batch ? s.batch->chunks.size() - s.batch->staged.size() : 0);
+}
+
+// Collects the meshes the worker finished, then hands it what is still to
+// mesh, nearest first: the batch's chunks from its levels, fresh ones from
+// the shown levels.
+void mesh(Session& s, MeshWorker& worker, const glm::dvec2& xy) {
+  for (MadeMesh& m : worker.take()) collect(s, std::move(m));
+  finish_batch(s);
+  if (s.queue_stale) {
+    std::vector<MeshJob> jobs;
+    if (s.batch) {
+      for (const ChunkKey& k : s.batch->chunks)
+        if (!s.batch->staged.count(k)) jobs.push_back({chunk_of(k), s.batch->levels});
+    }
+    for (const ChunkKey& k : s.fresh)
+      if (!s.batch || !s.batch->chunks.count(k)) jobs.push_back({chunk_of(k), s.levels});
     const double c = s.window.lattice().cell_size * s.window.chunk_size();
     const glm::dvec2 o = glm::dvec2(s.window.lattice().origin);
-    std::stable_sort(s.remesh.begin(), s.remesh.end(), [&](const glm::ivec3& a, const glm::ivec3& b) {
-      return glm::length(o + (glm::dvec2(a) + 0.5) * c - xy) < glm::length(o + (glm::dvec2(b) + 0.5) * c - xy);
-    });
-    worker.request(s.window, s.remesh);
+    auto distance = [&](const MeshJob& j) { return glm::length(o + (glm::dvec2(j.chunk) + 0.5) * c - xy); };
+    std::stable_sort(jobs.begin(), jobs.end(), [&](const MeshJob& a, const MeshJob& b) { return distance(a) < distance(b); });
+    worker.request(s.window, std::move(jobs));
+    s.queue_stale = false;
   }
   s.triangles = 0;
-  for (const auto& [k, m] : s.meshes) s.triangles += m.mesh.triangle_count();
+  for (const auto& [k, m] : s.meshes) s.triangles += m.mesh.mesh.triangle_count();
 }
 
 // The ground under (x, y): a ray cast straight down through the window.
@@ -477,10 +673,9 @@ void nav(Session& s, NavWorker& worker, const glm::dvec2& xy, const glm::dvec2& 
   s.nav_centre = xy;
 }
 
-bool render_frame(const Session& s, const Options& o, int frame, const glm::dvec2& xy, const glm::dvec2& dir) {
-  char name[64];
-  std::snprintf(name, sizeof name, "flythrough_%04d.png", frame);
-  const std::string path = (std::filesystem::path(o.png_dir) / name).string();
+// The render camera: 12 m behind the player and 9 m above the ground,
+// looking 20 m ahead (the levels of detail follow it too).
+ldc::CameraConfig view_of(const Session& s, const glm::dvec2& xy, const glm::dvec2& dir) {
   ldc::CameraConfig view;
   const double z = s.ground_z.value_or(10.0);
   view.position = glm::dvec3(xy - 12.0 * dir, z + 9.0);
@@ -488,11 +683,23 @@ bool render_frame(const Session& s, const Options& o, int frame, const glm::dvec
   view.fov_degrees = 70.0;
   view.width = 640;
   view.height = 360;
-  ldc::RenderOptions options;
-  options.shadows = true;
-  ldc::Queries q(s.window);
-  Result<ldc::Camera> camera = ldc::Camera::make(view);
-  Result<ldc::Image> image = camera.ok() ? ldc::render(q, *camera, options) : camera.status();
+  return view;
+}
+
+// The chunk meshes in view as one mesh, tinted by level (0 grey, 1 blue, 2 orange).
+ldc::TriangleMesh meshes_in_view(const Session& s, std::vector<glm::vec3>* colours) {
+  static const glm::vec3 kTint[3] = {{0.75f, 0.75f, 0.70f}, {0.50f, 0.68f, 0.92f}, {0.95f, 0.66f, 0.40f}};
+  ldc::TriangleMesh all;
+  for (const auto& [k, m] : s.meshes) {
+    const uint32_t base = uint32_t(all.positions.size());
+    all.positions.insert(all.positions.end(), m.mesh.mesh.positions.begin(), m.mesh.mesh.positions.end());
+    for (const glm::uvec3& t : m.mesh.mesh.triangles) all.triangles.push_back(t + base);
+    colours->insert(colours->end(), m.mesh.mesh.triangles.size(), kTint[std::clamp(m.level, 0, 2)]);
+  }
+  return all;
+}
+
+bool write_image(const Result<ldc::Image>& image, const std::string& path) {
   const Status st = image.ok() ? ldc::write_png(*image, path) : image.status();
   if (!st.ok()) {
     std::fprintf(stderr, "render failed: %s\n", st.to_string().c_str());
@@ -500,6 +707,70 @@ bool render_frame(const Session& s, const Options& o, int frame, const glm::dvec
   }
   std::printf("wrote %s\n", path.c_str());
   return true;
+}
+
+// Cracks in the chunk meshes in view: edges with one triangle, in meshes of
+// chunks whose 26 neighbours are all meshed too (or have nothing to mesh).
+// Chunk meshes share their seam vertices bit for bit, so vertices are welded
+// by position. A chunk's triangles meet only its neighbours', so with every
+// neighbour meshed from one level map there are none; a neighbourhood still
+// being re-meshed after a level change can show some for a while.
+size_t count_cracks(const Session& s) {
+  std::map<std::tuple<double, double, double>, uint32_t> ids;
+  auto id = [&](const glm::dvec3& p) { return ids.try_emplace({p.x, p.y, p.z}, uint32_t(ids.size())).first->second; };
+  std::map<std::pair<uint32_t, uint32_t>, int> uses;
+  std::map<ChunkKey, std::vector<std::pair<uint32_t, uint32_t>>> edges_of;
+  for (const auto& [k, m] : s.meshes) {
+    const ldc::ContourMesh& mesh = m.mesh.mesh;
+    for (const glm::uvec3& t : mesh.triangles) {
+      const uint32_t v[3] = {id(mesh.positions[t.x]), id(mesh.positions[t.y]), id(mesh.positions[t.z])};
+      for (int i = 0; i < 3; ++i) {
+        const std::pair<uint32_t, uint32_t> e = std::minmax(v[i], v[(i + 1) % 3]);
+        ++uses[e];
+        edges_of[k].push_back(e);
+      }
+    }
+  }
+  auto covered = [&](const glm::ivec3& c) { return s.meshes.count(key(c)) > 0 || quiet(s.window, c); };
+  size_t cracks = 0;
+  for (const auto& [k, edges] : edges_of) {
+    const glm::ivec3 c(std::get<0>(k), std::get<1>(k), std::get<2>(k));
+    bool inner = true;
+    for (int dz = -1; dz <= 1 && inner; ++dz)
+      for (int dy = -1; dy <= 1 && inner; ++dy)
+        for (int dx = -1; dx <= 1 && inner; ++dx) inner = covered(c + glm::ivec3(dx, dy, dz));
+    if (!inner) continue;
+    for (const auto& e : edges) cracks += uses[e] == 1;
+  }
+  return cracks;
+}
+
+// Two pictures of the frame: the world ray-traced (flythrough_N.png), and
+// the chunk meshes as they are, tinted by level (flythrough_lod_N.png).
+bool render_frame(const Session& s, const Options& o, int frame, const glm::dvec2& xy, const glm::dvec2& dir) {
+  char name[64], lod_name[64];
+  std::snprintf(name, sizeof name, "flythrough_%04d.png", frame);
+  std::snprintf(lod_name, sizeof lod_name, "flythrough_lod_%04d.png", frame);
+  ldc::RenderOptions options;
+  options.shadows = true;
+  ldc::Queries q(s.window);
+  Result<ldc::Camera> camera = ldc::Camera::make(view_of(s, xy, dir));
+  if (!write_image(camera.ok() ? ldc::render(q, *camera, options) : camera.status(),
+                   (std::filesystem::path(o.png_dir) / name).string()))
+    return false;
+  ldc::MeshRenderOptions mesh_options;
+  const ldc::TriangleMesh meshes = meshes_in_view(s, &mesh_options.triangle_colour);
+  const ldc::SourceLayout& layout = s.paged->layout();
+  size_t at_level = 0;  // shown at the level the camera's distance now asks (with no hysteresis)
+  for (const auto& [k, m] : s.meshes) {
+    const double d = ldc::chunk_distance(layout.lattice, layout.chunk_size, chunk_of(k), *view_of(s, xy, dir).position);
+    at_level += ldc::lod_level({kLodBands.start, 0.0}, d, 0) == m.level;
+  }
+  std::printf("frame %d: %zu chunk meshes drawn (%zu at the level their distance asks now), %zu cracks (one-triangle "
+              "edges between meshed neighbourhoods), %zu chunks waiting to be meshed\n",
+              frame, s.meshes.size(), at_level, count_cracks(s), waiting(s));
+  return write_image(camera.ok() ? ldc::render_mesh(meshes, *camera, mesh_options) : camera.status(),
+                     (std::filesystem::path(o.png_dir) / lod_name).string());
 }
 
 double percentile(std::vector<double> v, double p) {
@@ -566,7 +837,7 @@ int main(int argc, char** argv) {
   NavResults nav_results;
   {
     Prefetcher prefetcher(*s.paged);
-    MeshWorker worker(contour);
+    MeshWorker worker(contour, 1);  // one thread: a second one (tried) slows the frame on two cores
     NavWorker nav_worker(nav_results);
     // The first window and its meshes: what a game does behind its loading screen.
     Clock::time_point start = Clock::now();
@@ -574,10 +845,13 @@ int main(int argc, char** argv) {
     const glm::dvec2 first = track(layout, 1000.0 * o.size_km, 0.0, o.speed);
     Status st = page(s, prefetcher, layout, first, track(layout, 1000.0 * o.size_km, 1.0, o.speed), &changed);
     if (st.ok()) ground_ray(s, first);
-    mesh(s, worker, first, true);
-    while (st.ok() && worker.queued() > 0) std::this_thread::sleep_for(std::chrono::milliseconds(1));
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));  // the last mesh in flight
-    mesh(s, worker, first, false);
+    const glm::dvec2 first_dir = glm::normalize(track(layout, 1000.0 * o.size_km, 1.0, o.speed) - first);
+    set_levels(s, *view_of(s, first, first_dir).position);
+    mesh(s, worker, first);
+    while (st.ok() && waiting(s) > 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      mesh(s, worker, first);
+    }
     setup_ms = ms_since(start);
     if (!st.ok()) return std::fprintf(stderr, "setup: %s\n", st.to_string().c_str()), 1;
     std::printf("setup (first window, %zu chunk meshes): %.0f ms\n\n", s.meshes.size(), setup_ms);
@@ -589,27 +863,28 @@ int main(int argc, char** argv) {
       const double t = double(i) / kFps;
       const glm::dvec2 xy = track(layout, 1000.0 * o.size_km, t, o.speed);
       const glm::dvec2 ahead = track(layout, 1000.0 * o.size_km, t + 1.0, o.speed);
+      const glm::dvec2 dir = glm::normalize(ahead - xy);
       Frame f;
       start = Clock::now();
       st = page(s, prefetcher, layout, xy, ahead, &changed);
       f.page = ms_since(start);
       if (st.ok() && i % kFps == kFps / 2) {
         start = Clock::now();
-        st = dig(s, xy, contour);
+        st = dig(s, xy);
         f.edit = ms_since(start);
-        changed = true;  // re-mesh what the dig changed
         start = Clock::now();
         if (st.ok()) st = save(s);
         f.save = ms_since(start);
       }
       start = Clock::now();
-      if (st.ok()) mesh(s, worker, xy, changed);
+      if (st.ok()) set_levels(s, *view_of(s, xy, dir).position);
+      if (st.ok()) mesh(s, worker, xy);
       f.mesh = ms_since(start);
       start = Clock::now();
       if (st.ok()) ground_ray(s, xy);
       f.ray = ms_since(start);
       start = Clock::now();
-      if (st.ok()) nav(s, nav_worker, xy, glm::normalize(ahead - xy), f.edit > 0.0);
+      if (st.ok()) nav(s, nav_worker, xy, dir, f.edit > 0.0);
       f.nav = ms_since(start);
       if (!st.ok()) return std::fprintf(stderr, "frame %d: %s\n", i, st.to_string().c_str()), 1;
       frames.push_back(f);
@@ -618,7 +893,6 @@ int main(int argc, char** argv) {
                     xy.x, xy.y, f.total(), s.meshes.size(), s.triangles,
                     double(s.paged->stats().resident_bytes) / 1048576.0);
       }
-      const glm::dvec2 dir = glm::normalize(ahead - xy);
       if (!o.png_dir.empty() && (i % render_every == 0 || i == o.frames - 1) && !render_frame(s, o, i, xy, dir))
         return 1;
     }
@@ -637,7 +911,16 @@ int main(int argc, char** argv) {
   std::printf("meshes: %zu chunk meshes made on the mesh worker (%.0f ms of its time, %.1f ms each), %zu in view "
               "(%zu triangles), %zu waiting\n",
               s.meshed, worker_ms, s.meshed ? worker_ms / double(s.meshed) : 0.0, s.meshes.size(), s.triangles,
-              s.remesh.size());
+              waiting(s));
+  size_t per_level[3] = {0, 0, 0}, tris_per_level[3] = {0, 0, 0};
+  for (const auto& [k, m] : s.meshes) {
+    ++per_level[std::clamp(m.level, 0, 2)];
+    tris_per_level[std::clamp(m.level, 0, 2)] += m.mesh.mesh.triangle_count();
+  }
+  std::printf("levels of detail (1 from 12 m, 2 from 24 m): chunk meshes in view at level 0 / 1 / 2: %zu / %zu / %zu "
+              "(%zu / %zu / %zu triangles); %zu level changes, %zu batches of re-meshed chunks shown\n",
+              per_level[0], per_level[1], per_level[2], tris_per_level[0], tris_per_level[1], tris_per_level[2],
+              s.level_changes, s.batches);
   {
     std::lock_guard lock(nav_results.mutex);
     const std::vector<double>& b = nav_results.build_ms;
