@@ -124,7 +124,7 @@ int main(int argc, char** argv) {
   std::printf("\n## Chunks at mixed levels by distance (contour_levels)\n\n"
               "Each chunk's level by lod_level from its box's distance to a camera: level 1 from `near`, level 2 "
               "from `far` (landscape: camera (6, 6, 8) m, 12 and 24 m; meshes: the box's lower corner, 1/3 and "
-              "2/3 of the diagonal). levels ms = contour_levels without untangling (coarsening included); "
+              "2/3 of the diagonal). levels ms = contour_levels without untangling (each level read in place, nothing coarsened); "
               "untangle ms = untangle_mesh on it; level 0 ms = contour_world of the whole world without untangling, "
               "for scale. Raw = the mesh before untangling: boundary / non-manifold edges / non-manifold "
               "vertices (ldc's mesh_quality). Closed = after untangling, by mesh_quality; CGAL = the written OBJ "
