@@ -62,6 +62,7 @@ cpu=$(grep -m1 "model name" /proc/cpuinfo | cut -d: -f2- | sed 's/^ //')
     ./build/bench/bench_boolean_process --plots docs --ldc-args "" --ldc-args "--max-error 0"
   section "Game edits on the default landscape (issue 4)" "1 and 2 (column)" ./build/bench/bench_csg_game
   section "Levels of detail: every 2^k-th ray (issue 21)" "2" ./build/bench/bench_lod
+  section "Large worlds: paging and saving per chunk (issue 21)" "1 (throughput: 1 and 2)" ./build/bench/bench_store
   section "Game queries against Embree (issue 5)" "ldc and Embree 1 and 2 (columns)" ./build/bench/bench_query
   section "Pathfinding against Recast/Detour (issue 6)" "ldc and Detour 1" ./build/bench/bench_nav
   section "Voxel export against OpenVDB's solid voxelization (issue 7)" "ldc and OpenVDB 1 and 2 (columns)" \
