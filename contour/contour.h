@@ -184,6 +184,7 @@ struct ChunkMesh {
 struct ChunkMeshChange {
   glm::ivec3 chunk{0};
   uint64_t version = 0;
+  int level = 0;  // LevelChunkedMesh: the level of detail it was meshed at (0 otherwise)
   bool removed() const { return version == 0; }
 };
 
@@ -299,6 +300,59 @@ Result<ContourMesh> contour_levels(const World& world, const std::function<int(c
 Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chunk,
                                        const std::function<int(const glm::ivec3&)>& level_of_chunk,
                                        const ContourConfig& config = {}, ContourStats* stats = nullptr);
+
+// Chunk meshes at levels of detail, kept up to date: what ChunkedMesh is to
+// contour_chunk, for contour_chunk_levels. Holds every chunk's mesh at its
+// level (chunks the world's box holds, and the layer below it; chunks with
+// no surface near them hold none). update() re-meshes, all at once and from
+// one level map, every chunk within one chunk of a chunk whose rays changed
+// or whose level changed, so the meshes it holds always fit together: no
+// crack between levels at any moment. Levels come from a function of the
+// chunk (often lod_level of its distance to the camera; level(chunk) is
+// its level now, for hysteresis). Not thread-safe (one owner); each build
+// and update meshes in parallel inside (TBB) and gives the same meshes for
+// any thread count.
+class LevelChunkedMesh {
+ public:
+  using LevelOf = std::function<int(const glm::ivec3&)>;
+  explicit LevelChunkedMesh(ContourConfig config = {}) : config_(config) {}
+
+  // Meshes every chunk at level_of(chunk). On error (a bad config or level,
+  // box faces inside the solid, cancelled) the meshes stay as they were.
+  Status build(const World& world, const LevelOf& level_of, Context* ctx = nullptr);
+  // Re-meshes the chunks within one chunk of a chunk of `changed_chunks`
+  // (their rays changed) or of a chunk whose level_of() differs from its
+  // level now. Returns the meshes that changed (with their levels) or went.
+  // A world whose chunk box changed is meshed anew (every mesh reported).
+  // On error nothing changes.
+  Result<MeshUpdate> update(const World& world, std::span<const glm::ivec3> changed_chunks, const LevelOf& level_of,
+                            Context* ctx = nullptr);
+
+  const ChunkMesh* find(const glm::ivec3& chunk) const;
+  // The chunk's level now (clamped into the box; 0 before any build).
+  int level(const glm::ivec3& chunk) const;
+  // Every non-empty chunk mesh, sorted by chunk (z, y, x).
+  std::vector<const ChunkMesh*> chunks() const;
+  // All chunk meshes as one, their shared vertices welded (by cell and
+  // sheet): contour_levels's mesh before untangling.
+  ContourMesh assemble() const;
+  uint64_t version() const { return version_; }
+
+ private:
+  struct Box {
+    glm::ivec3 origin{0}, dims{0};
+    bool operator==(const Box&) const = default;
+  };
+  Result<std::vector<int8_t>> levels_of(const World& world, const LevelOf& level_of) const;
+  Status mesh_chunks(const World& world, const std::vector<glm::ivec3>& chunks, const std::vector<int8_t>& levels,
+                     std::vector<ChunkMesh>& out, Context* ctx) const;
+
+  ContourConfig config_;
+  Box box_;
+  std::vector<int8_t> levels_;  // per chunk of box_, x fastest
+  std::vector<ChunkMesh> meshes_;  // non-empty, sorted by chunk (z, y, x)
+  uint64_t version_ = 0;
+};
 
 // Marching cubes on the same data (vertices at the edge crossings, faces
 // resolved consistently): the baseline for tests and benchmarks.

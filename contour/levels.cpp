@@ -24,6 +24,7 @@
 #include <map>
 #include <memory>
 #include <mutex>
+#include <set>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -985,6 +986,199 @@ Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chu
   } catch (const std::bad_alloc&) {
     return Status(ErrorCode::kTooLarge, "contour_chunk_levels: out of memory");
   }
+}
+
+}  // namespace ldc
+
+// --- LevelChunkedMesh ----------------------------------------------------------
+
+namespace ldc {
+namespace {
+
+using LevelOf = LevelChunkedMesh::LevelOf;
+
+struct ChunkOrder {
+  bool operator()(const glm::ivec3& a, const glm::ivec3& b) const { return chunk_order_less(a, b); }
+};
+
+// The chunks contour_levels meshes, sorted by chunk (z, y, x).
+std::vector<glm::ivec3> meshable_chunks(const World& world) {
+  std::vector<glm::ivec3> out;
+  const glm::ivec3 lo = world.chunk_origin() - 1, hi = world.chunk_origin() + world.chunk_dims();
+  for (int z = lo.z; z < hi.z; ++z)
+    for (int y = lo.y; y < hi.y; ++y)
+      for (int x = lo.x; x < hi.x; ++x) out.emplace_back(x, y, z);
+  return out;
+}
+
+// A chunk whose 26 neighbours and itself are all empty or all solid: no surface near it.
+bool quiet_chunk(const World& world, const glm::ivec3& c) {
+  const ChunkKind kind = world.chunk_kind(c);
+  if (kind == ChunkKind::kMixed) return false;
+  for (int dz = -1; dz <= 1; ++dz)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (world.chunk_kind(c + glm::ivec3(dx, dy, dz)) != kind) return false;
+  return true;
+}
+
+bool same_mesh(const ChunkMesh& a, const ChunkMesh& b) {
+  return a.mesh.positions == b.mesh.positions && a.mesh.triangles == b.mesh.triangles &&
+         a.mesh.triangle_material == b.mesh.triangle_material && a.mesh.vertex_material == b.mesh.vertex_material;
+}
+
+size_t box_index(const glm::ivec3& origin, const glm::ivec3& dims, const glm::ivec3& chunk) {
+  const glm::ivec3 r = glm::clamp(chunk, origin, origin + dims - 1) - origin;
+  return (size_t(r.z) * size_t(dims.y) + size_t(r.y)) * size_t(dims.x) + size_t(r.x);
+}
+
+}  // namespace
+
+Result<std::vector<int8_t>> LevelChunkedMesh::levels_of(const World& world, const LevelOf& level_of) const {
+  if (!level_of) return Status(ErrorCode::kInvalidArgument, "LevelChunkedMesh: no level function");
+  LevelMap map;
+  if (Status s = map.build(world, level_of); !s.ok()) return s;
+  std::vector<int8_t> out;
+  world.for_each_chunk([&](const glm::ivec3& c, ChunkKind, const Chunk*) { out.push_back(int8_t(map.at(c))); });
+  return out;
+}
+
+Status LevelChunkedMesh::mesh_chunks(const World& world, const std::vector<glm::ivec3>& chunks,
+                                     const std::vector<int8_t>& levels, std::vector<ChunkMesh>& out,
+                                     Context* ctx) const {
+  const glm::ivec3 origin = world.chunk_origin(), dims = world.chunk_dims();
+  auto level_of = [&](const glm::ivec3& c) { return int(levels[box_index(origin, dims, c)]); };
+  out.assign(chunks.size(), ChunkMesh());
+  std::mutex mutex;
+  Status first_error;
+  std::atomic<size_t> done{0};
+  tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t i) {
+    if (ctx && ctx->cancelled()) return;
+    out[i].chunk = chunks[i];
+    if (quiet_chunk(world, chunks[i])) return;
+    Result<ChunkMesh> m = contour_chunk_levels(world, chunks[i], level_of, config_);
+    if (m.ok()) {
+      out[i] = std::move(m).value();
+    } else {
+      std::lock_guard<std::mutex> lock(mutex);
+      if (first_error.ok()) first_error = m.status();
+    }
+    const size_t n = done.fetch_add(1) + 1;
+    if (ctx && n % 16 == 0) ctx->report_progress("contour levels", double(n) / double(chunks.size()));
+  });
+  if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "LevelChunkedMesh: cancelled");
+  return first_error;
+}
+
+Status LevelChunkedMesh::build(const World& world, const LevelOf& level_of, Context* ctx) {
+  Result<MeshUpdate> u = update(world, {}, level_of, ctx);  // box_ differs from a built one's: a whole build
+  if (!u.ok()) return u.status();
+  return {};
+}
+
+Result<MeshUpdate> LevelChunkedMesh::update(const World& world, std::span<const glm::ivec3> changed_chunks,
+                                            const LevelOf& level_of, Context* ctx) {
+  if (Status s = check_contour_config(config_); !s.ok()) return s;
+  Result<std::vector<int8_t>> levels = levels_of(world, level_of);
+  if (!levels.ok()) return levels.status();
+  const Box box{world.chunk_origin(), world.chunk_dims()};
+  const bool whole = !(box == box_) || levels_.empty();
+  // The chunks to mesh: every one, or those within one chunk of a change.
+  std::set<glm::ivec3, ChunkOrder> targets;
+  if (whole) {
+    for (const glm::ivec3& c : meshable_chunks(world)) targets.insert(c);
+  } else {
+    std::vector<glm::ivec3> changed(changed_chunks.begin(), changed_chunks.end());
+    world.for_each_chunk([&](const glm::ivec3& c, ChunkKind, const Chunk*) {
+      const size_t i = box_index(box.origin, box.dims, c);
+      if (levels.value()[i] != levels_[i]) changed.push_back(c);
+    });
+    const glm::ivec3 lo = box.origin - 1, hi = box.origin + box.dims;
+    for (const glm::ivec3& c : changed)
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
+            if (glm::all(glm::greaterThanEqual(n, lo)) && glm::all(glm::lessThan(n, hi))) targets.insert(n);
+          }
+  }
+  std::vector<glm::ivec3> order(targets.begin(), targets.end());
+  std::vector<ChunkMesh> made;
+  if (Status s = mesh_chunks(world, order, levels.value(), made, ctx); !s.ok()) return s;
+  // Merge: what was meshed replaces what was there; a whole build drops the rest.
+  MeshUpdate result;
+  result.chunks_remeshed = made.size();
+  const uint64_t version = version_ + 1;
+  std::set<glm::ivec3, ChunkOrder> old_present;
+  for (const ChunkMesh& m : meshes_) old_present.insert(m.chunk);
+  std::map<glm::ivec3, ChunkMesh, ChunkOrder> next;
+  for (ChunkMesh& m : meshes_) {
+    if (!whole) next.emplace(m.chunk, std::move(m));
+  }
+  auto level_now = [&](const glm::ivec3& c) { return int(levels.value()[box_index(box.origin, box.dims, c)]); };
+  for (ChunkMesh& m : made) {
+    auto it = next.find(m.chunk);
+    const bool empty = m.mesh.triangles.empty();
+    if (it != next.end() && !empty && same_mesh(it->second, m)) continue;  // unchanged
+    if (empty) {
+      if (it != next.end()) next.erase(it);
+      if (old_present.count(m.chunk)) result.changes.push_back({m.chunk, 0, level_now(m.chunk)});
+      continue;
+    }
+    m.version = version;
+    result.changes.push_back({m.chunk, version, level_now(m.chunk)});
+    next[m.chunk] = std::move(m);
+  }
+  if (whole) {  // meshes of the old box that the new one has not
+    for (const glm::ivec3& c : old_present)
+      if (!next.count(c)) result.changes.push_back({c, 0, 0});
+  }
+  std::sort(result.changes.begin(), result.changes.end(),
+            [](const ChunkMeshChange& a, const ChunkMeshChange& b) { return chunk_order_less(a.chunk, b.chunk); });
+  meshes_.clear();
+  for (auto& [c, m] : next) meshes_.push_back(std::move(m));
+  if (!result.changes.empty()) version_ = version;
+  box_ = box;
+  levels_ = std::move(levels).value();
+  return result;
+}
+
+const ChunkMesh* LevelChunkedMesh::find(const glm::ivec3& chunk) const {
+  auto it = std::lower_bound(meshes_.begin(), meshes_.end(), chunk,
+                             [](const ChunkMesh& m, const glm::ivec3& c) { return chunk_order_less(m.chunk, c); });
+  return it != meshes_.end() && it->chunk == chunk ? &*it : nullptr;
+}
+
+int LevelChunkedMesh::level(const glm::ivec3& chunk) const {
+  return levels_.empty() ? 0 : int(levels_[box_index(box_.origin, box_.dims, chunk)]);
+}
+
+std::vector<const ChunkMesh*> LevelChunkedMesh::chunks() const {
+  std::vector<const ChunkMesh*> out;
+  for (const ChunkMesh& m : meshes_) out.push_back(&m);
+  return out;
+}
+
+ContourMesh LevelChunkedMesh::assemble() const {
+  ContourMesh out;
+  std::map<std::tuple<int, int, int, int>, uint32_t> index;
+  for (const ChunkMesh& m : meshes_) {
+    std::vector<uint32_t> map(m.mesh.positions.size());
+    for (size_t i = 0; i < map.size(); ++i) {
+      const glm::ivec3 c = m.vertex_cell[i];
+      auto [it, added] = index.try_emplace({c.x, c.y, c.z, int(m.vertex_sheet[i])}, uint32_t(out.positions.size()));
+      if (added) {
+        out.positions.push_back(m.mesh.positions[i]);
+        out.normals.push_back(m.mesh.normals[i]);
+        out.vertex_material.push_back(m.mesh.vertex_material[i]);
+      }
+      map[i] = it->second;
+    }
+    for (const glm::uvec3& t : m.mesh.triangles) out.triangles.emplace_back(map[t.x], map[t.y], map[t.z]);
+    out.triangle_material.insert(out.triangle_material.end(), m.mesh.triangle_material.begin(),
+                                 m.mesh.triangle_material.end());
+  }
+  return out;
 }
 
 }  // namespace ldc

@@ -7,11 +7,13 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "contour/contour.h"
+#include "csg/csg.h"
 #include "ldc/build.h"
 #include "ldc/lod.h"
 #include "ldc/store.h"
@@ -384,6 +386,115 @@ TEST(LodLevels, AChunkMeshDependsOnlyOnItsNeighbours) {
   EXPECT_GT(whole.mesh.triangle_count(), 0u);
   EXPECT_EQ(whole.mesh.positions, alone.mesh.positions);
   EXPECT_EQ(whole.mesh.triangles, alone.mesh.triangles);
+}
+
+// --- LevelChunkedMesh: chunk meshes at levels, kept up to date -----------------------
+
+namespace levels_test {
+
+std::vector<Triangle> sorted_triangles(const ContourMesh& m) {
+  std::vector<Triangle> t;
+  add_triangles(m, t);
+  std::sort(t.begin(), t.end(), triangle_less);
+  return t;
+}
+
+// Levels by distance from a point, as a camera would give them.
+LevelChunkedMesh::LevelOf by_distance(const World& w, const glm::dvec3& from, double near, double far) {
+  return [&w, from, near, far](const glm::ivec3& c) {
+    return lod_level({.start = {near, far}, .hysteresis = 0.0}, chunk_distance(w.lattice(), w.chunk_size(), c, from), 0);
+  };
+}
+
+}  // namespace levels_test
+
+TEST(LevelChunkedMesh, ABuildAssemblesToContourLevelsMesh) {
+  const World w = spot_world(160);
+  auto level_of = [](const glm::ivec3& c) { return levels_test::scrambled_level(c, 3, 5); };
+  LevelChunkedMesh meshes;
+  ASSERT_TRUE(meshes.build(w, level_of).ok());
+  const ContourMesh assembled = meshes.assemble();
+  const ContourMesh whole = contour_levels(w, level_of, levels_test::plain_config()).value();
+  EXPECT_EQ(assembled.vertex_count(), whole.vertex_count());
+  EXPECT_TRUE(levels_test::sorted_triangles(assembled) == levels_test::sorted_triangles(whole));
+  EXPECT_TRUE(mesh_quality(assembled).watertight());
+  EXPECT_GT(meshes.version(), 0u);
+  for (const ChunkMesh* m : meshes.chunks()) EXPECT_EQ(m->version, meshes.version());
+}
+
+// The camera moves: the levels change, and the update re-meshes what they
+// touch, giving what a fresh build at the new levels gives; chunks no level
+// change reaches keep their meshes (and versions) and are not reported.
+TEST(LevelChunkedMesh, AnUpdateAfterTheLevelsChangeEqualsAFreshBuild) {
+  const World w = spot_world(160);
+  const glm::dvec3 lo = w.box().min, hi = w.box().max;
+  const double diag = glm::length(hi - lo);
+  auto before = levels_test::by_distance(w, lo, diag / 3.0, 2.0 * diag / 3.0);
+  auto after = levels_test::by_distance(w, lo + 0.15 * (hi - lo), diag / 3.0, 2.0 * diag / 3.0);
+  LevelChunkedMesh meshes;
+  ASSERT_TRUE(meshes.build(w, before).ok());
+  const uint64_t built = meshes.version();
+  std::map<std::tuple<int, int, int>, uint64_t> versions;
+  for (const ChunkMesh* m : meshes.chunks()) versions[{m->chunk.x, m->chunk.y, m->chunk.z}] = m->version;
+  Result<MeshUpdate> u = meshes.update(w, {}, after);
+  ASSERT_TRUE(u.ok()) << u.status().message();
+  ASSERT_FALSE(u->changes.empty());
+  EXPECT_GT(meshes.version(), built);
+  LevelChunkedMesh fresh;
+  ASSERT_TRUE(fresh.build(w, after).ok());
+  EXPECT_TRUE(levels_test::sorted_triangles(meshes.assemble()) == levels_test::sorted_triangles(fresh.assemble()));
+  size_t kept = 0;
+  for (const ChunkMesh* m : meshes.chunks()) {
+    const bool reported = std::any_of(u->changes.begin(), u->changes.end(),
+                                      [&](const ChunkMeshChange& c) { return c.chunk == m->chunk; });
+    if (reported) {
+      EXPECT_EQ(m->version, meshes.version());
+      const auto it = std::find_if(u->changes.begin(), u->changes.end(),
+                                   [&](const ChunkMeshChange& c) { return c.chunk == m->chunk; });
+      EXPECT_EQ(it->level, after(m->chunk));
+    } else {
+      EXPECT_EQ(m->version, (versions[{m->chunk.x, m->chunk.y, m->chunk.z}]));
+      ++kept;
+    }
+    EXPECT_EQ(meshes.level(m->chunk), after(m->chunk));
+  }
+  EXPECT_GT(kept, 0u);
+}
+
+// A dig: the update with its dirty chunks gives what a fresh build of the
+// dug world gives.
+TEST(LevelChunkedMesh, AnUpdateAfterADigEqualsAFreshBuild) {
+  World w = spot_world(160);
+  auto level_of = [](const glm::ivec3& c) { return levels_test::scrambled_level(c, 3, 8); };
+  LevelChunkedMesh meshes;
+  ASSERT_TRUE(meshes.build(w, level_of).ok());
+  const WorldBox box = w.box();
+  WorldEditor editor(std::move(w));
+  ASSERT_TRUE(editor.apply(Brush::sphere(0.5 * (box.min + box.max), 0.12 * glm::length(box.max - box.min)),
+                           EditOp::kSubtract)
+                  .ok());
+  std::vector<glm::ivec3> dirty;
+  for (const DirtyChunk& d : editor.take_dirty()) dirty.push_back(d.chunk);
+  ASSERT_FALSE(dirty.empty());
+  Result<MeshUpdate> u = meshes.update(editor.world(), dirty, level_of);
+  ASSERT_TRUE(u.ok()) << u.status().message();
+  EXPECT_FALSE(u->changes.empty());
+  LevelChunkedMesh fresh;
+  ASSERT_TRUE(fresh.build(editor.world(), level_of).ok());
+  EXPECT_TRUE(levels_test::sorted_triangles(meshes.assemble()) == levels_test::sorted_triangles(fresh.assemble()));
+  EXPECT_TRUE(mesh_quality(meshes.assemble()).watertight());
+}
+
+TEST(LevelChunkedMesh, ABadLevelIsRefusedAndTheMeshesStay) {
+  const World w = spot_world(96);
+  LevelChunkedMesh meshes;
+  ASSERT_TRUE(meshes.build(w, [](const glm::ivec3&) { return 1; }).ok());
+  const size_t triangles = meshes.assemble().triangle_count();
+  Result<MeshUpdate> u = meshes.update(w, {}, [](const glm::ivec3&) { return 7; });
+  ASSERT_FALSE(u.ok());
+  EXPECT_EQ(u.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_EQ(meshes.assemble().triangle_count(), triangles);
+  EXPECT_EQ(meshes.level(w.chunk_origin()), 1);
 }
 
 TEST(LodLevels, AChunkOutsideTheMeshableBoxIsRefused) {
