@@ -44,7 +44,8 @@ function(ldc_install_component name target)
 endfunction()
 
 ldc_install_component(core ldc_core HEADERS ldc/build.h ldc/context.h ldc/io.h ldc/materials.h ldc/mesh.h
-  ldc/query.h ldc/status.h ldc/terrain.h ldc/version.h ldc/world.h)
+  ldc/query.h ldc/status.h ldc/terrain.h ldc/version.h ldc/world.h
+  ldc/lod.h ldc/chunk_source.h ldc/chunk_log.h ldc/store.h)
 ldc_install_component(contour ldc_contour HEADERS contour/contour.h)
 ldc_install_component(contour_openmesh ldc_contour_openmesh HEADERS contour/openmesh.h)
 ldc_install_component(meshio ldc_meshio HEADERS meshio/meshio.h contour/export.h)  # export.h: deprecated forward

@@ -1,6 +1,7 @@
 #include "live/live.h"
 
 #include <chrono>
+#include <cmath>
 #include <map>
 #include <optional>
 #include <set>
@@ -38,6 +39,9 @@ struct LiveState {
   LiveConfig config;
 
   std::optional<ChunkedMesh> meshes;
+  std::optional<LevelChunkedMesh> level_meshes;  // instead of meshes, with config.lod
+  glm::dvec3 camera{0.0};
+  bool camera_moved = false;
   std::vector<DirtyChunk> mesh_pending;
   std::map<glm::ivec3, ChunkMeshChange, ChunkOrder> mesh_changes;  // since the last update()
   size_t remeshed_since_update = 0;
@@ -89,8 +93,27 @@ struct LiveState {
     dirty_since_update.insert(d.chunk);
   }
 
+  // Each chunk's level by its distance to the camera, from its level now.
+  LevelChunkedMesh::LevelOf level_of() const {
+    return [this](const glm::ivec3& c) {
+      const int now = level_meshes ? level_meshes->level(c) : 0;
+      return lod_level(*config.lod, chunk_distance(world().lattice(), world().chunk_size(), c, camera), now);
+    };
+  }
+
+  // The chunks whose meshes a change of `dirty` may change.
+  std::vector<glm::ivec3> mesh_chunks_of(std::span<const DirtyChunk> dirty) const {
+    if (!config.lod) return chunks_a_remesh_may_change(dirty, config.contour, world().chunk_size());
+    std::set<glm::ivec3, ChunkOrder> out;  // LevelChunkedMesh: the 26 neighbours
+    for (const DirtyChunk& d : dirty)
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) out.insert(d.chunk + glm::ivec3(dx, dy, dz));
+    return {out.begin(), out.end()};
+  }
+
   void record_mesh_flags(std::span<const DirtyChunk> dirty) {
-    for (const glm::ivec3& ch : chunks_a_remesh_may_change(dirty, config.contour, world().chunk_size())) {
+    for (const glm::ivec3& ch : mesh_chunks_of(dirty)) {
       if (!world().contains_chunk(ch)) continue;
       auto [it, added] = changes.try_emplace(ch);
       if (added) it->second.chunk = ch;
@@ -104,6 +127,15 @@ struct LiveState {
 Status check_live_config(const LiveConfig& config, const World& world) {
   if (Status s = check_boolean_config(config.boolean); !s.ok()) return s;
   if (Status s = check_contour_config(config.contour); !s.ok()) return s;
+  if (config.lod) {
+    if (Status s = check_lod_bands(*config.lod); !s.ok()) return s;
+    if (int(config.lod->start.size()) > max_lod_level(world.chunk_size())) {
+      return Status(ErrorCode::kInvalidArgument,
+                    "live config: lod has " + std::to_string(config.lod->start.size()) + " bands; chunks of " +
+                        std::to_string(world.chunk_size()) + " cells allow up to " +
+                        std::to_string(max_lod_level(world.chunk_size())));
+    }
+  }
   if (config.nav) {
     if (Status s = check_nav_config(config.nav_config, world); !s.ok()) return s;
   }
@@ -141,7 +173,7 @@ void LiveWorld::fan_out(const std::vector<DirtyChunk>& dirty) {
   for (const DirtyChunk& d : dirty) s.record_change(d);
   s.record_mesh_flags(dirty);
   // Only what is built needs the list: a later build reads the world as it is.
-  if (s.meshes) s.mesh_pending.insert(s.mesh_pending.end(), dirty.begin(), dirty.end());
+  if (s.meshes || s.level_meshes) s.mesh_pending.insert(s.mesh_pending.end(), dirty.begin(), dirty.end());
   if (s.nav) s.nav_pending.insert(s.nav_pending.end(), dirty.begin(), dirty.end());
   for (auto& [id, c] : s.cascades) c->invalidate(dirty);
   if (!dirty.empty()) s.queries_stale = true;
@@ -169,6 +201,17 @@ Status LiveWorld::undo(const EditReceipt& receipt) {
 
 Status LiveWorld::update_meshes(Context* ctx) {
   detail::LiveState& s = *state_;
+  if (s.level_meshes) {
+    if (s.mesh_pending.empty() && !s.camera_moved) return {};
+    std::vector<glm::ivec3> chunks;
+    for (const DirtyChunk& d : s.mesh_pending) chunks.push_back(d.chunk);
+    Result<MeshUpdate> r = s.level_meshes->update(s.world(), chunks, s.level_of(), ctx);
+    if (!r.ok()) return r.status();
+    s.note_mesh_changes(r.value());
+    s.mesh_pending.clear();
+    s.camera_moved = false;
+    return {};
+  }
   if (!s.meshes || s.mesh_pending.empty()) return {};
   Result<MeshUpdate> r = s.meshes->update(s.world(), s.mesh_pending, ctx);
   if (!r.ok()) return r.status();
@@ -229,6 +272,23 @@ size_t LiveWorld::pending_changes() const { return state_->changes.size(); }
 
 Status LiveWorld::enable_meshes(const ContourConfig& config, Context* ctx) {
   detail::LiveState& s = *state_;
+  if (s.config.lod) {
+    if (Status st = check_contour_config(config); !st.ok()) return st;
+    LevelChunkedMesh built(config);
+    if (Status st = built.build(s.world(), s.level_of(), ctx); !st.ok()) return st;
+    s.note_rebuild(s.meshes ? &*s.meshes : nullptr, nullptr);
+    if (s.level_meshes) {
+      for (const ChunkMesh* m : s.level_meshes->chunks()) s.mesh_changes[m->chunk] = {m->chunk, 0};
+    }
+    for (const ChunkMesh* m : built.chunks()) s.mesh_changes[m->chunk] = {m->chunk, m->version, built.level(m->chunk)};
+    s.meshes.reset();
+    s.level_meshes.emplace(std::move(built));
+    s.mesh_pending.clear();
+    s.camera_moved = false;
+    s.config.contour = config;
+    s.config.meshes = true;
+    return {};
+  }
   Result<ChunkedMesh> built = ChunkedMesh::create(s.world(), config, ctx);
   if (!built) return built.status();
   s.note_rebuild(s.meshes ? &*s.meshes : nullptr, &*built);
@@ -242,7 +302,11 @@ Status LiveWorld::enable_meshes(const ContourConfig& config, Context* ctx) {
 void LiveWorld::disable_meshes() {
   detail::LiveState& s = *state_;
   if (s.meshes) s.note_rebuild(&*s.meshes, nullptr);
+  if (s.level_meshes) {
+    for (const ChunkMesh* m : s.level_meshes->chunks()) s.mesh_changes[m->chunk] = {m->chunk, 0};
+  }
   s.meshes.reset();
+  s.level_meshes.reset();
   s.mesh_pending.clear();
   s.config.meshes = false;
 }
@@ -277,6 +341,17 @@ Status LiveWorld::set_max_path_nodes(int max_nodes) {
 }
 
 const ChunkedMesh* LiveWorld::meshes() const { return state_->meshes ? &*state_->meshes : nullptr; }
+const LevelChunkedMesh* LiveWorld::level_meshes() const {
+  return state_->level_meshes ? &*state_->level_meshes : nullptr;
+}
+
+void LiveWorld::set_camera(const glm::dvec3& position) {
+  detail::LiveState& s = *state_;
+  if (!std::isfinite(position.x) || !std::isfinite(position.y) || !std::isfinite(position.z)) return;
+  if (position == s.camera) return;
+  s.camera = position;
+  s.camera_moved = true;
+}
 const NavMesh* LiveWorld::nav() const { return state_->nav ? &*state_->nav : nullptr; }
 NavMesh* LiveWorld::nav() { return state_->nav ? &*state_->nav : nullptr; }
 

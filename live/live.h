@@ -6,7 +6,9 @@
 // that takes and does the fan-out of dirty chunks in one place:
 //
 //   - the World and its WorldEditor (csg/csg.h): apply, apply_batch, undo;
-//   - chunk meshes (contour/contour.h, ChunkedMesh), when turned on;
+//   - chunk meshes (contour/contour.h, ChunkedMesh), when turned on; at
+//     levels of detail by distance to the camera (LevelChunkedMesh) with
+//     LiveConfig::lod;
 //   - the navigation mesh and a path query on it (nav/nav.h), when turned on;
 //   - game queries (ldc/query.h, Queries): ray and sphere casts, overlaps;
 //   - voxel cascades (voxelize/voxelize.h), any number, added by the caller.
@@ -38,6 +40,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -45,6 +48,7 @@
 
 #include "contour/contour.h"
 #include "csg/csg.h"
+#include "ldc/lod.h"
 #include "ldc/context.h"
 #include "ldc/query.h"
 #include "ldc/status.h"
@@ -69,6 +73,13 @@ struct LiveConfig {
   // "Game edits"). Turn it on for meshes that feed physics decomposition or
   // export.
   ContourConfig contour{.untangle = false};
+  // Chunk meshes at levels of detail by distance to the camera
+  // (set_camera): each chunk at lod_level(*lod, its distance, its level now),
+  // meshed by LevelChunkedMesh (seams between levels closed; no relaxation
+  // or untangling), read with level_meshes() instead of meshes(). A change
+  // of level re-meshes the chunk and its 26 neighbours at the next update.
+  // [Limit: check_lod_bands; at most max_lod_level(C) bands] [Default: none: one level]
+  std::optional<LodBands> lod;
   // Keep a navigation mesh: built at create (or enable_nav), updated from
   // the dirty chunks at each update. [Default: off]
   bool nav = false;
@@ -153,7 +164,13 @@ class LiveWorld {
 
   // Null when off. The meshes and nav mesh are as of the last update of
   // that consumer: call update() (or update_meshes / update_nav) first.
+  // meshes() is null and level_meshes() set when config.lod is.
   const ChunkedMesh* meshes() const;
+  const LevelChunkedMesh* level_meshes() const;
+  // Where the camera is, for levels of detail (config.lod): the next
+  // update_meshes() gives each chunk its level by its distance from here.
+  // [Units: m] [Limit: finite; otherwise ignored] [Default: the world's origin]
+  void set_camera(const glm::dvec3& position);
   const NavMesh* nav() const;
   // The nav mesh for changes that need no edit: off-mesh links
   // (NavMesh::add_link / remove_link; not while its path query runs). They

@@ -313,5 +313,71 @@ TEST(LiveWorld, ATaskArenaCapsTheThreadsItsWorkRunsOn) {
   EXPECT_EQ(threads.count(), 1u);
 }
 
+// --- Levels of detail (LiveConfig::lod) ----------------------------------------------
+
+namespace live_lod {
+
+LiveConfig lod_config() {
+  LiveConfig config;
+  config.meshes = true;
+  config.lod = LodBands{.start = {5.0}, .hysteresis = 0.5};  // chunks of 16 cells: levels 0 and 1
+  return config;
+}
+
+// The live world's level meshes against a fresh LevelChunkedMesh at the same levels.
+::testing::AssertionResult level_meshes_equal_fresh_build(const LiveWorld& live) {
+  const LevelChunkedMesh& meshes = *live.level_meshes();
+  LevelChunkedMesh fresh(live.config().contour);
+  if (!fresh.build(live.world(), [&](const glm::ivec3& c) { return meshes.level(c); }).ok())
+    return ::testing::AssertionFailure() << "fresh build failed";
+  if (test::sorted_triangle_positions(meshes.assemble()) != test::sorted_triangle_positions(fresh.assemble()))
+    return ::testing::AssertionFailure() << "the triangles differ from a fresh build's";
+  return ::testing::AssertionSuccess();
+}
+
+}  // namespace live_lod
+
+TEST(LiveWorldLod, MeshesFollowTheCameraAndReportTheirLevels) {
+  LiveWorld live = LiveWorld::create(small_landscape(), live_lod::lod_config()).value();
+  ASSERT_EQ(live.meshes(), nullptr);
+  ASSERT_NE(live.level_meshes(), nullptr);
+  EXPECT_EQ(live.level_meshes()->level({0, 0, 0}), 0);  // the camera starts at the origin
+  EXPECT_EQ(live.level_meshes()->level(live.world().chunk_origin() + live.world().chunk_dims() - 1), 1);
+  live.set_camera({16.0, 16.0, 4.0});
+  const LiveUpdate u = live.update().value();
+  ASSERT_FALSE(u.meshes.empty());
+  for (const ChunkMeshChange& c : u.meshes) {
+    if (c.removed()) continue;
+    EXPECT_EQ(c.level, live.level_meshes()->level(c.chunk));
+    ASSERT_NE(live.level_meshes()->find(c.chunk), nullptr);
+  }
+  EXPECT_EQ(live.level_meshes()->level({0, 0, 0}), 1);
+  EXPECT_TRUE(live_lod::level_meshes_equal_fresh_build(live));
+  EXPECT_TRUE(mesh_quality(live.level_meshes()->assemble()).watertight());
+  EXPECT_TRUE(live.update()->meshes.empty());  // nothing moved, nothing dug
+}
+
+TEST(LiveWorldLod, ADigIsRemeshedAtTheChunksLevels) {
+  LiveWorld live = LiveWorld::create(small_landscape(), live_lod::lod_config()).value();
+  live.set_camera({8.0, 8.0, 4.0});
+  ASSERT_TRUE(live.update().ok());
+  const double z = ground_z(live.queries(), 8.0, 8.0);
+  ASSERT_TRUE(live.apply(Brush::sphere({8.0, 8.0, z}, 1.5), EditOp::kSubtract).ok());
+  const LiveUpdate u = live.update().value();
+  EXPECT_FALSE(u.meshes.empty());
+  EXPECT_TRUE(live_lod::level_meshes_equal_fresh_build(live));
+  EXPECT_TRUE(mesh_quality(live.level_meshes()->assemble()).watertight());
+}
+
+TEST(LiveWorldLod, MoreBandsThanTheChunkSizeAllowsAreRefused) {
+  LiveConfig config = live_lod::lod_config();
+  config.lod->start = {5.0, 10.0};
+  Result<LiveWorld> r = LiveWorld::create(small_landscape(), config);
+  ASSERT_FALSE(r.ok());
+  EXPECT_EQ(r.status().code(), ErrorCode::kInvalidArgument);
+  EXPECT_NE(r.status().message().find("lod has 2 bands; chunks of 16 cells allow up to 1"), std::string::npos)
+      << r.status().message();
+}
+
 }  // namespace
 }  // namespace ldc

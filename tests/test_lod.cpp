@@ -302,30 +302,6 @@ TEST(LodLevels, LevelsByDistanceOnALandscapeMeshClosed) {
   EXPECT_GT(stats.chunks_meshed, 0u);
 }
 
-namespace levels_test {
-
-using Triangle = std::array<glm::dvec3, 3>;
-
-// A triangle by its corners' positions, turned to start at the smallest.
-Triangle canonical(const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) {
-  auto less = [](const glm::dvec3& p, const glm::dvec3& q) { return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z); };
-  Triangle t{a, b, c};
-  while (less(t[1], t[0]) || less(t[2], t[0])) t = {t[1], t[2], t[0]};
-  return t;
-}
-
-bool triangle_less(const Triangle& a, const Triangle& b) {
-  for (int i = 0; i < 3; ++i) {
-    if (a[i] != b[i]) return std::tie(a[i].x, a[i].y, a[i].z) < std::tie(b[i].x, b[i].y, b[i].z);
-  }
-  return false;
-}
-
-void add_triangles(const ContourMesh& m, std::vector<Triangle>& out) {
-  for (const glm::uvec3& t : m.triangles) out.push_back(canonical(m.positions[t.x], m.positions[t.y], m.positions[t.z]));
-}
-
-}  // namespace levels_test
 
 // Chunk by chunk (an engine's way): the chunk meshes together are the whole
 // mesh, triangle for triangle with the same positions to the bit, so they
@@ -334,8 +310,8 @@ TEST(LodLevels, ChunkMeshesTogetherAreTheWholeMesh) {
   const World w = spot_world(160);
   auto level_of = [&](const glm::ivec3& c) { return levels_test::scrambled_level(c, 3, 7); };
   const ContourMesh whole = contour_levels(w, level_of, levels_test::plain_config()).value();
-  std::vector<levels_test::Triangle> expected, got;
-  levels_test::add_triangles(whole, expected);
+  std::vector<test::TrianglePositions> got;
+  const std::vector<test::TrianglePositions> expected = test::sorted_triangle_positions(whole);
   size_t own = 0;
   for (int z = w.chunk_origin().z - 1; z < w.chunk_origin().z + w.chunk_dims().z; ++z)
     for (int y = w.chunk_origin().y - 1; y < w.chunk_origin().y + w.chunk_dims().y; ++y)
@@ -347,11 +323,11 @@ TEST(LodLevels, ChunkMeshesTogetherAreTheWholeMesh) {
         for (size_t i = 0; i < cm.own_vertices; ++i)
           EXPECT_EQ(cm.vertex_cell[i] >> w.chunk_shift(), glm::ivec3(x, y, z)) << "chunk " << x << "," << y << "," << z;
         own += cm.own_vertices;
-        levels_test::add_triangles(cm.mesh, got);
+        const std::vector<test::TrianglePositions> part = test::sorted_triangle_positions(cm.mesh);
+        got.insert(got.end(), part.begin(), part.end());
       }
   EXPECT_EQ(own, whole.vertex_count());
-  std::sort(expected.begin(), expected.end(), levels_test::triangle_less);
-  std::sort(got.begin(), got.end(), levels_test::triangle_less);
+  std::sort(got.begin(), got.end(), test::triangle_positions_less);
   ASSERT_EQ(got.size(), expected.size());
   EXPECT_TRUE(got == expected);
 }
@@ -392,12 +368,6 @@ TEST(LodLevels, AChunkMeshDependsOnlyOnItsNeighbours) {
 
 namespace levels_test {
 
-std::vector<Triangle> sorted_triangles(const ContourMesh& m) {
-  std::vector<Triangle> t;
-  add_triangles(m, t);
-  std::sort(t.begin(), t.end(), triangle_less);
-  return t;
-}
 
 // Levels by distance from a point, as a camera would give them.
 LevelChunkedMesh::LevelOf by_distance(const World& w, const glm::dvec3& from, double near, double far) {
@@ -416,7 +386,7 @@ TEST(LevelChunkedMesh, ABuildAssemblesToContourLevelsMesh) {
   const ContourMesh assembled = meshes.assemble();
   const ContourMesh whole = contour_levels(w, level_of, levels_test::plain_config()).value();
   EXPECT_EQ(assembled.vertex_count(), whole.vertex_count());
-  EXPECT_TRUE(levels_test::sorted_triangles(assembled) == levels_test::sorted_triangles(whole));
+  EXPECT_TRUE(test::sorted_triangle_positions(assembled) == test::sorted_triangle_positions(whole));
   EXPECT_TRUE(mesh_quality(assembled).watertight());
   EXPECT_GT(meshes.version(), 0u);
   for (const ChunkMesh* m : meshes.chunks()) EXPECT_EQ(m->version, meshes.version());
@@ -442,7 +412,7 @@ TEST(LevelChunkedMesh, AnUpdateAfterTheLevelsChangeEqualsAFreshBuild) {
   EXPECT_GT(meshes.version(), built);
   LevelChunkedMesh fresh;
   ASSERT_TRUE(fresh.build(w, after).ok());
-  EXPECT_TRUE(levels_test::sorted_triangles(meshes.assemble()) == levels_test::sorted_triangles(fresh.assemble()));
+  EXPECT_TRUE(test::sorted_triangle_positions(meshes.assemble()) == test::sorted_triangle_positions(fresh.assemble()));
   size_t kept = 0;
   for (const ChunkMesh* m : meshes.chunks()) {
     const bool reported = std::any_of(u->changes.begin(), u->changes.end(),
@@ -481,7 +451,7 @@ TEST(LevelChunkedMesh, AnUpdateAfterADigEqualsAFreshBuild) {
   EXPECT_FALSE(u->changes.empty());
   LevelChunkedMesh fresh;
   ASSERT_TRUE(fresh.build(editor.world(), level_of).ok());
-  EXPECT_TRUE(levels_test::sorted_triangles(meshes.assemble()) == levels_test::sorted_triangles(fresh.assemble()));
+  EXPECT_TRUE(test::sorted_triangle_positions(meshes.assemble()) == test::sorted_triangle_positions(fresh.assemble()));
   EXPECT_TRUE(mesh_quality(meshes.assemble()).watertight());
 }
 

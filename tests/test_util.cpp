@@ -145,4 +145,25 @@ void append_mesh(TriangleMesh& a, const TriangleMesh& b) {
   return ::testing::AssertionSuccess();
 }
 
+namespace {
+bool position_less(const glm::dvec3& p, const glm::dvec3& q) { return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z); }
+}  // namespace
+
+bool triangle_positions_less(const TrianglePositions& a, const TrianglePositions& b) {
+  for (int i = 0; i < 3; ++i)
+    if (a[i] != b[i]) return position_less(a[i], b[i]);
+  return false;
+}
+
+std::vector<TrianglePositions> sorted_triangle_positions(const ContourMesh& mesh) {
+  std::vector<TrianglePositions> out;
+  for (const glm::uvec3& t : mesh.triangles) {
+    TrianglePositions c{mesh.positions[t.x], mesh.positions[t.y], mesh.positions[t.z]};
+    while (position_less(c[1], c[0]) || position_less(c[2], c[0])) c = {c[1], c[2], c[0]};
+    out.push_back(c);
+  }
+  std::sort(out.begin(), out.end(), triangle_positions_less);
+  return out;
+}
+
 }  // namespace ldc::test

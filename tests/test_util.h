@@ -1,7 +1,9 @@
 // Helpers shared by the tests.
 #pragma once
 
+#include <array>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -39,5 +41,13 @@ void append_mesh(TriangleMesh& a, const TriangleMesh& b);
 // per cell, and triangles by their cells (the order of copies and triangles
 // may differ: an incremental update and a fresh build agree up to that).
 ::testing::AssertionResult same_chunk_meshes(const ChunkedMesh& a, const ChunkedMesh& b);
+
+// A mesh's triangles as their corners' positions, each turned to start at its
+// smallest corner, sorted: equal for two meshes with the same triangles
+// whatever their vertex numbering and order.
+using TrianglePositions = std::array<glm::dvec3, 3>;
+std::vector<TrianglePositions> sorted_triangle_positions(const ContourMesh& mesh);
+// Their order: by corners, each by x, y, z.
+bool triangle_positions_less(const TrianglePositions& a, const TrianglePositions& b);
 
 }  // namespace ldc::test
