@@ -111,7 +111,7 @@ struct Cell {
 Cell cell_at_doubled(const LevelMap& levels, const glm::ivec3& doubled) {
   Cell c;
   c.level = levels.at(levels.chunk_of_doubled(doubled));
-  c.lo = (doubled >> (c.level + 1)) << c.level;
+  c.lo = (doubled >> (c.level + 1)) * (1 << c.level);  // floor to the level-k cell (a multiply: the coordinate may be negative)
   return c;
 }
 
