@@ -346,6 +346,11 @@ class LevelChunkedMesh {
   Result<std::vector<int8_t>> levels_of(const World& world, const LevelOf& level_of) const;
   Status mesh_chunks(const World& world, const std::vector<glm::ivec3>& chunks, const std::vector<int8_t>& levels,
                      std::vector<ChunkMesh>& out, Context* ctx) const;
+  // The chunks within one of a changed one (rays, or a level other than levels_), sorted.
+  std::vector<glm::ivec3> near_changes(const World& world, std::span<const glm::ivec3> changed_chunks,
+                                       const std::vector<int8_t>& levels) const;
+  // Takes the meshes made in: changed ones get the next version; returns the changes.
+  MeshUpdate merge(std::vector<ChunkMesh>& made, bool whole, const LevelOf& level_now);
 
   ContourConfig config_;
   Box box_;

@@ -929,6 +929,54 @@ Result<ContourMesh> contour_levels(const World& world, const std::function<int(c
   }
 }
 
+namespace {
+
+// The thread's mesher for contour_chunk_levels, kept between calls: its
+// regions' buffers are allocated once (allocating them was most of a small
+// chunk's cost).
+ChunkMesher& thread_mesher(const LevelMap& levels, const World& world, const ContourConfig& config) {
+  thread_local std::unique_ptr<ChunkMesher> kept;
+  if (kept) kept->rebind(&levels, &world, &config);
+  else kept = std::make_unique<ChunkMesher>(&levels, &world, &config);
+  return *kept;
+}
+
+// One chunk's mesh: its polygons, its own vertices, then its neighbours' it uses.
+Result<ChunkMesh> chunk_mesh(const World& world, const glm::ivec3& chunk, ChunkMesher& mesher, const LevelMap& levels,
+                             ContourStats* stats) {
+  ChunkPart own;
+  mesher.mesh(chunk, own);
+  ChunkAndNeighbours lookup(mesher, levels, own, chunk, world.chunk_size());
+  ChunkMesh out;
+  out.chunk = chunk;
+  size_t missing = 0;
+  for (const OwnedEdge& e : own.edges)
+    if (!emit_polygon(e, lookup, out.mesh.triangles, out.mesh.triangle_material)) ++missing;
+  if (missing > 0) {
+    return Status(ErrorCode::kInternal, "contour_chunk_levels: " + std::to_string(missing) +
+                                            " crossing edges found no vertex in a cell around them");
+  }
+  out.own_vertices = own.vertices.size();
+  auto add = [&](const LevelVertex& v) {
+    out.mesh.positions.push_back(world.lattice().to_world(v.x));
+    out.mesh.normals.push_back(v.normal);
+    out.mesh.vertex_material.push_back(v.material);
+    out.vertex_cell.push_back(v.cell_lo);
+    out.vertex_sheet.push_back(v.sheet);
+  };
+  for (const LevelVertex& v : own.vertices) add(v);
+  for (const LevelVertex* v : lookup.used()) add(*v);
+  if (stats) {
+    *stats = ContourStats();
+    stats->cells = own.cells;
+    stats->quads = own.edges.size();
+    stats->chunks_meshed = 1;
+  }
+  return out;
+}
+
+}  // namespace
+
 Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chunk,
                                        const std::function<int(const glm::ivec3&)>& level_of_chunk,
                                        const ContourConfig& config, ContourStats* stats) {
@@ -947,41 +995,8 @@ Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chu
     ScopedTimer timer(nullptr, "contour_chunk_levels");
     LevelMap levels;
     if (s = levels.build(world, level_of_chunk, chunk - kLevelMapReach, chunk + kLevelMapReach + 1); !s.ok()) return s;
-    // One mesher per thread, kept between calls: its regions' buffers are
-    // allocated once (allocating them was most of a small chunk's cost).
-    thread_local std::unique_ptr<ChunkMesher> kept;
-    if (kept) kept->rebind(&levels, &world, &config);
-    else kept = std::make_unique<ChunkMesher>(&levels, &world, &config);
-    ChunkMesher& mesher = *kept;
-    ChunkPart own;
-    mesher.mesh(chunk, own);
-    ChunkAndNeighbours lookup(mesher, levels, own, chunk, world.chunk_size());
-    ChunkMesh out;
-    out.chunk = chunk;
-    size_t missing = 0;
-    for (const OwnedEdge& e : own.edges)
-      if (!emit_polygon(e, lookup, out.mesh.triangles, out.mesh.triangle_material)) ++missing;
-    if (missing > 0) {
-      return Status(ErrorCode::kInternal, "contour_chunk_levels: " + std::to_string(missing) +
-                                              " crossing edges found no vertex in a cell around them");
-    }
-    out.own_vertices = own.vertices.size();
-    auto add = [&](const LevelVertex& v) {
-      out.mesh.positions.push_back(world.lattice().to_world(v.x));
-      out.mesh.normals.push_back(v.normal);
-      out.mesh.vertex_material.push_back(v.material);
-      out.vertex_cell.push_back(v.cell_lo);
-      out.vertex_sheet.push_back(v.sheet);
-    };
-    for (const LevelVertex& v : own.vertices) add(v);
-    for (const LevelVertex* v : lookup.used()) add(*v);
-    if (stats) {
-      *stats = ContourStats();
-      stats->cells = own.cells;
-      stats->quads = own.edges.size();
-      stats->chunks_meshed = 1;
-      stats->seconds = timer.seconds();
-    }
+    Result<ChunkMesh> out = chunk_mesh(world, chunk, thread_mesher(levels, world, config), levels, stats);
+    if (stats) stats->seconds = timer.seconds();
     return out;
   } catch (const std::bad_alloc&) {
     return Status(ErrorCode::kTooLarge, "contour_chunk_levels: out of memory");
@@ -1083,39 +1098,46 @@ Result<MeshUpdate> LevelChunkedMesh::update(const World& world, std::span<const 
   if (!levels.ok()) return levels.status();
   const Box box{world.chunk_origin(), world.chunk_dims()};
   const bool whole = !(box == box_) || levels_.empty();
-  // The chunks to mesh: every one, or those within one chunk of a change.
-  std::set<glm::ivec3, ChunkOrder> targets;
-  if (whole) {
-    for (const glm::ivec3& c : meshable_chunks(world)) targets.insert(c);
-  } else {
-    std::vector<glm::ivec3> changed(changed_chunks.begin(), changed_chunks.end());
-    world.for_each_chunk([&](const glm::ivec3& c, ChunkKind, const Chunk*) {
-      const size_t i = box_index(box.origin, box.dims, c);
-      if (levels.value()[i] != levels_[i]) changed.push_back(c);
-    });
-    const glm::ivec3 lo = box.origin - 1, hi = box.origin + box.dims;
-    for (const glm::ivec3& c : changed)
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) {
-            const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
-            if (glm::all(glm::greaterThanEqual(n, lo)) && glm::all(glm::lessThan(n, hi))) targets.insert(n);
-          }
-  }
-  std::vector<glm::ivec3> order(targets.begin(), targets.end());
+  const std::vector<glm::ivec3> targets = whole ? meshable_chunks(world) : near_changes(world, changed_chunks, levels.value());
   std::vector<ChunkMesh> made;
-  if (Status s = mesh_chunks(world, order, levels.value(), made, ctx); !s.ok()) return s;
-  // Merge: what was meshed replaces what was there; a whole build drops the rest.
+  if (Status s = mesh_chunks(world, targets, levels.value(), made, ctx); !s.ok()) return s;
+  MeshUpdate result = merge(made, whole, [&](const glm::ivec3& c) {
+    return int(levels.value()[box_index(box.origin, box.dims, c)]);
+  });
+  box_ = box;
+  levels_ = std::move(levels).value();
+  return result;
+}
+
+std::vector<glm::ivec3> LevelChunkedMesh::near_changes(const World& world, std::span<const glm::ivec3> changed_chunks,
+                                                       const std::vector<int8_t>& levels) const {
+  std::vector<glm::ivec3> changed(changed_chunks.begin(), changed_chunks.end());
+  world.for_each_chunk([&](const glm::ivec3& c, ChunkKind, const Chunk*) {
+    const size_t i = box_index(box_.origin, box_.dims, c);
+    if (levels[i] != levels_[i]) changed.push_back(c);
+  });
+  const glm::ivec3 lo = box_.origin - 1, hi = box_.origin + box_.dims;
+  std::set<glm::ivec3, ChunkOrder> out;
+  for (const glm::ivec3& c : changed)
+    for (int dz = -1; dz <= 1; ++dz)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
+          if (glm::all(glm::greaterThanEqual(n, lo)) && glm::all(glm::lessThan(n, hi))) out.insert(n);
+        }
+  return {out.begin(), out.end()};
+}
+
+MeshUpdate LevelChunkedMesh::merge(std::vector<ChunkMesh>& made, bool whole, const LevelOf& level_now) {
   MeshUpdate result;
   result.chunks_remeshed = made.size();
   const uint64_t version = version_ + 1;
   std::set<glm::ivec3, ChunkOrder> old_present;
   for (const ChunkMesh& m : meshes_) old_present.insert(m.chunk);
-  std::map<glm::ivec3, ChunkMesh, ChunkOrder> next;
+  std::map<glm::ivec3, ChunkMesh, ChunkOrder> next;  // a whole build keeps nothing of the old meshes
   for (ChunkMesh& m : meshes_) {
     if (!whole) next.emplace(m.chunk, std::move(m));
   }
-  auto level_now = [&](const glm::ivec3& c) { return int(levels.value()[box_index(box.origin, box.dims, c)]); };
   for (ChunkMesh& m : made) {
     auto it = next.find(m.chunk);
     const bool empty = m.mesh.triangles.empty();
@@ -1129,17 +1151,13 @@ Result<MeshUpdate> LevelChunkedMesh::update(const World& world, std::span<const 
     result.changes.push_back({m.chunk, version, level_now(m.chunk)});
     next[m.chunk] = std::move(m);
   }
-  if (whole) {  // meshes of the old box that the new one has not
-    for (const glm::ivec3& c : old_present)
-      if (!next.count(c)) result.changes.push_back({c, 0, 0});
-  }
+  for (const glm::ivec3& c : old_present)  // a whole build: meshes of the old box that the new one has not
+    if (whole && !next.count(c)) result.changes.push_back({c, 0, 0});
   std::sort(result.changes.begin(), result.changes.end(),
             [](const ChunkMeshChange& a, const ChunkMeshChange& b) { return chunk_order_less(a.chunk, b.chunk); });
   meshes_.clear();
   for (auto& [c, m] : next) meshes_.push_back(std::move(m));
   if (!result.changes.empty()) version_ = version;
-  box_ = box;
-  levels_ = std::move(levels).value();
   return result;
 }
 

@@ -463,35 +463,38 @@ int level_at(double d, const std::optional<int>& previous) { return ldc::lod_lev
 
 // The window's chunks' levels by distance to the camera, with hysteresis.
 // When no batch is under way and some chunk's level changed, starts one
-// with the new levels. New window chunks get their level in the shown map
-// (and the batch's): no shown mesh reads them yet.
-void set_levels(Session& s, const glm::dvec3& camera) {
+// with the new levels. When the window moved, new chunks get their level in
+// the shown map (and the batch's): no shown mesh reads them yet.
+void set_levels(Session& s, const glm::dvec3& camera, bool window_changed) {
   const ldc::SourceLayout& layout = s.paged->layout();
+  auto distance = [&](const glm::ivec3& c) { return ldc::chunk_distance(layout.lattice, layout.chunk_size, c, camera); };
+  // The window's chunks, each at its level in `from` or (new) by distance;
+  // chunks that left the window are dropped.
   auto with_new_chunks = [&](const LevelsPtr& from) {
-    auto next = std::make_shared<Levels>(*from);
+    auto next = std::make_shared<Levels>();
+    next->id = from->id;
     s.window.for_each_chunk([&](const glm::ivec3& c, ldc::ChunkKind, const ldc::Chunk*) {
-      if (!next->map.count(key(c)))
-        next->map[key(c)] = level_at(ldc::chunk_distance(layout.lattice, layout.chunk_size, c, camera), std::nullopt);
+      auto it = from->map.find(key(c));
+      next->map[key(c)] = it != from->map.end() ? it->second : level_at(distance(c), std::nullopt);
     });
     return LevelsPtr(std::move(next));
   };
-  s.levels = with_new_chunks(s.levels);
-  if (s.batch) {
-    s.batch->levels = with_new_chunks(s.batch->levels);
-    return;
+  if (window_changed) {  // new maps only when the window moved
+    s.levels = with_new_chunks(s.levels);
+    if (s.batch) s.batch->levels = with_new_chunks(s.batch->levels);
   }
-  auto next = std::make_shared<Levels>(*s.levels);
-  next->id = s.next_levels_id++;
-  std::vector<glm::ivec3> changed;
-  for (auto& [k, level] : next->map) {
-    const glm::ivec3 c = chunk_of(k);
-    const int now = level_at(ldc::chunk_distance(layout.lattice, layout.chunk_size, c, camera), level);
-    if (now != level) changed.push_back(c);
-    level = now;
+  if (s.batch) return;
+  std::vector<std::pair<glm::ivec3, int>> changed;
+  for (const auto& [k, level] : s.levels->map) {
+    const int now = level_at(distance(chunk_of(k)), level);
+    if (now != level) changed.emplace_back(chunk_of(k), now);
   }
   if (changed.empty()) return;
+  auto next = std::make_shared<Levels>(*s.levels);
+  next->id = s.next_levels_id++;
+  for (const auto& [c, level] : changed) next->map[key(c)] = level;
   const LevelsPtr levels(std::move(next));
-  for (const glm::ivec3& c : changed) add_change(s, c, levels);
+  for (const auto& [c, level] : changed) add_change(s, c, levels);
   s.level_changes += changed.size();
 }
 
@@ -846,7 +849,7 @@ int main(int argc, char** argv) {
     Status st = page(s, prefetcher, layout, first, track(layout, 1000.0 * o.size_km, 1.0, o.speed), &changed);
     if (st.ok()) ground_ray(s, first);
     const glm::dvec2 first_dir = glm::normalize(track(layout, 1000.0 * o.size_km, 1.0, o.speed) - first);
-    set_levels(s, *view_of(s, first, first_dir).position);
+    set_levels(s, *view_of(s, first, first_dir).position, true);
     mesh(s, worker, first);
     while (st.ok() && waiting(s) > 0) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
@@ -877,7 +880,7 @@ int main(int argc, char** argv) {
         f.save = ms_since(start);
       }
       start = Clock::now();
-      if (st.ok()) set_levels(s, *view_of(s, xy, dir).position);
+      if (st.ok()) set_levels(s, *view_of(s, xy, dir).position, changed);
       if (st.ok()) mesh(s, worker, xy);
       f.mesh = ms_since(start);
       start = Clock::now();
