@@ -5,8 +5,10 @@
 //   mixed and uniform apart; and chunks per second on 1 and 2 threads.
 // - Page-in from disk: the mixed chunks committed to a chunk log
 //   (ChunkLog::commit), the log opened again, each chunk read back with
-//   ChunkLog::find (pread, CRC-32, decompression, validation). The file is in
-//   the OS page cache after the commit: this is a warm read, not a cold disk.
+//   ChunkLog::find (pread, CRC-32, decompression, validation): once with the
+//   file in the OS page cache, once with its pages dropped before each read
+//   (posix_fadvise DONTNEED; they are clean after the commit's fsync), so
+//   that the read comes from the disk.
 // - Save: a 2 m sphere dug into a window of the landscape (WorldEditor),
 //   its changed chunks committed (appended with CRC-32, two fsyncs), per dig
 //   and per chunk; 20 digs along a line.
@@ -14,6 +16,9 @@
 // incremental save of one dig <= 2 ms.
 //
 // Usage: bench_store [--quick] [DIR]   (DIR: where the log goes; default /tmp)
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -101,7 +106,18 @@ double chunks_per_second(const std::vector<glm::ivec3>& chunks, int threads) {
   return double(chunks.size()) / s;
 }
 
-std::vector<double> page_in_from_log(const std::string& path, const Generated& g) {
+// Drops the file's pages from the OS page cache (they are clean after the
+// commit's fsync), so that the next read comes from the disk.
+void evict_from_page_cache(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) std::abort();
+  (void)::posix_fadvise(fd, 0, 0, POSIX_FADV_DONTNEED);
+  ::close(fd);
+}
+
+// Each mixed chunk read back from the log: warm (the file in the page cache)
+// or cold (its pages dropped before each read).
+std::vector<double> page_in_from_log(const std::string& path, const Generated& g, bool cold) {
   auto source = ldc::make_terrain_source(world_config(), 0.2, 32).value();
   ldc::ChunkLogCreateOptions create;
   create.overwrite = true;
@@ -114,6 +130,7 @@ std::vector<double> page_in_from_log(const std::string& path, const Generated& g
   const ldc::ChunkLog log = ldc::ChunkLog::open(path).value();
   std::vector<double> ms;
   for (const auto& [c, s] : g.mixed) {
+    if (cold) evict_from_page_cache(path);
     const Clock::time_point t = Clock::now();
     std::optional<ldc::StoredChunk> read = log.find(c).value();
     ms.push_back(ms_since(t));
@@ -180,15 +197,17 @@ int main(int argc, char** argv) {
   auto layout = ldc::make_terrain_source(world_config(), 0.2, 32).value()->layout();
   const std::vector<glm::ivec3> chunks = block(layout, columns);
   std::printf("\nThe 4 km x 4 km landscape (h = 0.2 m, C = 32, 64 arches), %d x %d columns of %d chunks near its "
-              "middle (%zu chunks). Log at %s (in the page cache after its commit: a warm read). Times in ms.\n\n",
+              "middle (%zu chunks). Log at %s. Times in ms.\n\n",
               columns, columns, layout.box.chunk_dims.z, chunks.size(), path.c_str());
   const Generated g = generate_one_by_one(chunks);
-  const std::vector<double> from_log = page_in_from_log(path, g);
+  const std::vector<double> from_log = page_in_from_log(path, g, false);
+  const std::vector<double> from_disk = page_in_from_log(path, g, true);
   const Saves saves = dig_and_save(path, quick ? 5 : 20);
   std::printf("| what | count | min | median | p95 | max |\n|---|---|---|---|---|---|\n");
   row("page-in of a mixed chunk from the generator", g.mixed_ms);
   row("page-in of a uniform chunk from the generator", g.uniform_ms);
-  row("page-in of a mixed chunk from the chunk log (warm; target <= 0.5)", from_log);
+  row("page-in of a mixed chunk from the chunk log, in the page cache", from_log);
+  row("page-in of a mixed chunk from the chunk log, from the disk (target <= 0.5)", from_disk);
   row("save of one 2 m dig (commit, two fsyncs; target <= 2)", saves.per_dig_ms);
   row("save per changed chunk (commit time / chunks)", saves.per_chunk_ms);
   std::printf("\n%zu chunks saved in %zu digs. Generation throughput: %.0f chunks/s on 1 thread, %.0f on 2.\n",
