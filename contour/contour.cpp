@@ -41,10 +41,6 @@ Status check_contour_config(const ContourConfig& c) {
   return {};
 }
 
-namespace {
-
-// Nothing to mesh when the chunk and all 26 around it are uniform and alike:
-// its region (the chunk plus a margin smaller than a chunk) holds no surface.
 bool chunk_is_quiet(const World& w, const glm::ivec3& ch) {
   ChunkKind kind = w.chunk_kind(ch);
   if (kind == ChunkKind::kMixed) return false;
@@ -55,8 +51,6 @@ bool chunk_is_quiet(const World& w, const glm::ivec3& ch) {
   return true;
 }
 
-// The chunks to mesh: the world's, and one layer below it on each axis, whose
-// cells straddle the box's lower faces.
 std::vector<glm::ivec3> chunks_to_mesh(const World& w) {
   std::vector<glm::ivec3> out;
   const glm::ivec3 lo = w.chunk_origin() - 1, hi = w.chunk_origin() + w.chunk_dims();
@@ -65,6 +59,9 @@ std::vector<glm::ivec3> chunks_to_mesh(const World& w) {
       for (int x = lo.x; x < hi.x; ++x) out.emplace_back(x, y, z);
   return out;
 }
+
+namespace {
+
 
 // Meshes `chunks` in parallel; empty results are dropped. Sorted by chunk.
 Result<std::vector<ChunkMesh>> mesh_chunks(const World& w, const std::vector<glm::ivec3>& chunks,

@@ -200,6 +200,14 @@ struct MeshUpdate {
 std::vector<glm::ivec3> chunks_a_remesh_may_change(std::span<const DirtyChunk> dirty, const ContourConfig& config,
                                                    int chunk_size);
 
+// Whether a chunk and its 26 neighbours are all empty or all solid: no
+// surface near it, so every mesher here gives it an empty mesh (an engine
+// can skip it).
+bool chunk_is_quiet(const World& world, const glm::ivec3& chunk);
+// The chunks the meshers mesh: the world's, and the layer below its box on
+// each axis (whose cells straddle the box's lower faces), sorted by chunk (z, y, x).
+std::vector<glm::ivec3> chunks_to_mesh(const World& world);
+
 // Meshes one chunk. Chunks that are empty or solid, and whose neighbours
 // along the low side are too, produce an empty mesh without reading a ray.
 Result<ChunkMesh> contour_chunk(const World& world, const glm::ivec3& chunk,

@@ -1016,27 +1016,6 @@ struct ChunkOrder {
   bool operator()(const glm::ivec3& a, const glm::ivec3& b) const { return chunk_order_less(a, b); }
 };
 
-// The chunks contour_levels meshes, sorted by chunk (z, y, x).
-std::vector<glm::ivec3> meshable_chunks(const World& world) {
-  std::vector<glm::ivec3> out;
-  const glm::ivec3 lo = world.chunk_origin() - 1, hi = world.chunk_origin() + world.chunk_dims();
-  for (int z = lo.z; z < hi.z; ++z)
-    for (int y = lo.y; y < hi.y; ++y)
-      for (int x = lo.x; x < hi.x; ++x) out.emplace_back(x, y, z);
-  return out;
-}
-
-// A chunk whose 26 neighbours and itself are all empty or all solid: no surface near it.
-bool quiet_chunk(const World& world, const glm::ivec3& c) {
-  const ChunkKind kind = world.chunk_kind(c);
-  if (kind == ChunkKind::kMixed) return false;
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx)
-        if (world.chunk_kind(c + glm::ivec3(dx, dy, dz)) != kind) return false;
-  return true;
-}
-
 bool same_mesh(const ChunkMesh& a, const ChunkMesh& b) {
   return a.mesh.positions == b.mesh.positions && a.mesh.triangles == b.mesh.triangles &&
          a.mesh.triangle_material == b.mesh.triangle_material && a.mesh.vertex_material == b.mesh.vertex_material;
@@ -1070,7 +1049,7 @@ Status LevelChunkedMesh::mesh_chunks(const World& world, const std::vector<glm::
   tbb::parallel_for(size_t{0}, chunks.size(), [&](size_t i) {
     if (ctx && ctx->cancelled()) return;
     out[i].chunk = chunks[i];
-    if (quiet_chunk(world, chunks[i])) return;
+    if (chunk_is_quiet(world, chunks[i])) return;
     Result<ChunkMesh> m = contour_chunk_levels(world, chunks[i], level_of, config_);
     if (m.ok()) {
       out[i] = std::move(m).value();
@@ -1098,7 +1077,7 @@ Result<MeshUpdate> LevelChunkedMesh::update(const World& world, std::span<const 
   if (!levels.ok()) return levels.status();
   const Box box{world.chunk_origin(), world.chunk_dims()};
   const bool whole = !(box == box_) || levels_.empty();
-  const std::vector<glm::ivec3> targets = whole ? meshable_chunks(world) : near_changes(world, changed_chunks, levels.value());
+  const std::vector<glm::ivec3> targets = whole ? chunks_to_mesh(world) : near_changes(world, changed_chunks, levels.value());
   std::vector<ChunkMesh> made;
   if (Status s = mesh_chunks(world, targets, levels.value(), made, ctx); !s.ok()) return s;
   MeshUpdate result = merge(made, whole, [&](const glm::ivec3& c) {

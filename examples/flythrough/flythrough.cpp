@@ -416,20 +416,8 @@ bool meshable(const Session& s, const glm::ivec3& c, const ldc::SourceLayout& la
   return glm::all(glm::greaterThanEqual(c, lo)) && glm::all(glm::lessThan(c, hi));
 }
 
-// Whether a chunk and its 26 neighbours are all air or all solid: no surface
-// passes through it, so it has no mesh to make.
-bool quiet(const ldc::World& window, const glm::ivec3& c) {
-  const ldc::ChunkKind kind = window.chunk_kind(c);
-  if (kind == ldc::ChunkKind::kMixed) return false;
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx)
-        if (window.chunk_kind(c + glm::ivec3(dx, dy, dz)) != kind) return false;
-  return true;
-}
-
 bool wants_mesh(const Session& s, const glm::ivec3& c) {
-  return meshable(s, c, s.paged->layout()) && !quiet(s.window, c);
+  return meshable(s, c, s.paged->layout()) && !ldc::chunk_is_quiet(s.window, c);
 }
 
 // Whether c is within one chunk of a chunk the batch changed: a chunk's mesh
@@ -734,7 +722,7 @@ size_t count_cracks(const Session& s) {
       }
     }
   }
-  auto covered = [&](const glm::ivec3& c) { return s.meshes.count(key(c)) > 0 || quiet(s.window, c); };
+  auto covered = [&](const glm::ivec3& c) { return s.meshes.count(key(c)) > 0 || ldc::chunk_is_quiet(s.window, c); };
   size_t cracks = 0;
   for (const auto& [k, edges] : edges_of) {
     const glm::ivec3 c(std::get<0>(k), std::get<1>(k), std::get<2>(k));
