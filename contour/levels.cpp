@@ -8,10 +8,13 @@
 // finest level of the chunks that touch that line. So both cells sharing a
 // piece see the same polygon of nodes, and every edge between two
 // consecutive nodes (a "minimal edge", of length 2^m) is an edge of the
-// level-m world, whose crossing coarsen() keeps exactly. The sheets of a cell
-// are the loops its polygons' segments close into (the face rule of
-// detail/cell_sheets.h, generalised from squares to polygons: each run of
-// inside nodes is cut off by one segment); one vertex per sheet, and one
+// level-m world, whose crossing coarsen() keeps exactly (read here in place:
+// a Region with stride 2^m). The sheets of a cell are the loops its
+// polygons' segments close into (the face rule of detail/cell_sheets.h,
+// generalised from squares to polygons: each run of inside nodes is cut off
+// by one segment; a piece whose two cells would both link two of its
+// segments into one loop cuts off its outside runs instead, from both
+// sides, as the uniform mesher joins a face); one vertex per sheet, and one
 // polygon per crossing minimal edge, joining the sheets of the 3 or 4 cells
 // around it. That is the uniform mesher's argument for a closed 2-manifold,
 // unchanged: every segment lies on one polygon shared by two cells, and every
