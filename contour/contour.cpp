@@ -62,7 +62,6 @@ std::vector<glm::ivec3> chunks_to_mesh(const World& w) {
 
 namespace {
 
-
 // Meshes `chunks` in parallel; empty results are dropped. Sorted by chunk.
 Result<std::vector<ChunkMesh>> mesh_chunks(const World& w, const std::vector<glm::ivec3>& chunks,
                                            const ContourConfig& config, Context* ctx, ContourStats& stats) {

@@ -337,6 +337,9 @@ class LevelChunkedMesh {
                             Context* ctx = nullptr);
 
   const ChunkMesh* find(const glm::ivec3& chunk) const;
+  // The chunks whose meshes a change of `changed` (rays or level) may change:
+  // each and its 26 neighbours, sorted by chunk_order_less, each once.
+  static std::vector<glm::ivec3> chunks_a_change_reaches(std::span<const glm::ivec3> changed);
   // The chunk's level now (clamped into the box; 0 before any build).
   int level(const glm::ivec3& chunk) const;
   // Every non-empty chunk mesh, sorted by chunk (z, y, x).

@@ -47,12 +47,7 @@ using detail::CellPlanes;
 using detail::EdgeCrossing;
 using detail::Qef;
 using detail::Region;
-
-glm::ivec3 unit(int axis) {
-  glm::ivec3 e(0);
-  e[axis] = 1;
-  return e;
-}
+using detail::axis_unit;
 
 // The level of every chunk: the world's, and any other one as its nearest
 // chunk of the world (the layer below the box holds cells too).
@@ -107,7 +102,6 @@ struct Cell {
   glm::ivec3 lo{0};
   int level = 0;
   int size() const { return 1 << level; }
-  bool operator==(const Cell&) const = default;
 };
 
 // The cell holding a point given in half lattice cells (off every cell face).
@@ -161,7 +155,7 @@ class LevelReader {
     if (level == focus_level_ && in_focus(lower) && lower[axis] < focus_hi_[axis])
       return focus_.crossing(axis, lower >> level);
     const glm::ivec3 at = lower >> level;
-    return holding(level, at, at + unit(axis)).crossing(axis, at);
+    return holding(level, at, at + axis_unit(axis)).crossing(axis, at);
   }
 
  private:
@@ -259,7 +253,6 @@ struct CellCrossing {
 struct Piece {
   int begin = 0, end = 0;      // its nodes in CellShape::nodes, counter-clockwise seen from outside the cell
   glm::ivec3 across_doubled;   // a point (half cells) inside the cell across the piece
-  glm::ivec4 key;              // axis, and the lowest corner: the same from both cells
 };
 
 struct CellShape {
@@ -291,30 +284,11 @@ int line_level(const LevelMap& levels, const glm::ivec3& a, int axis, int chunk_
   return level;
 }
 
-// Appends a face's one piece, its four corners only.
-void add_square(int axis, int side, const glm::ivec3& corner, int s, const glm::ivec3& across_doubled,
-                CellShape& shape) {
-  const int first = side ? axis_u(axis) : axis_v(axis), second = side ? axis_v(axis) : axis_u(axis);
-  Piece piece;
-  piece.begin = int(shape.nodes.size());
-  glm::ivec3 n = corner;
-  shape.nodes.push_back(n);
-  n[first] += s;
-  shape.nodes.push_back(n);
-  n[second] += s;
-  shape.nodes.push_back(n);
-  n[first] -= s;
-  shape.nodes.push_back(n);
-  piece.end = piece.begin + 4;
-  piece.across_doubled = across_doubled;
-  piece.key = glm::ivec4(axis, corner);
-  shape.pieces.push_back(piece);
-}
-
 // Appends one piece: a square of side q at `corner` on face (axis, side),
-// its sides cut at their lines' finest level.
+// its sides cut at their lines' finest level (with `cut_sides`; otherwise
+// its four corners only).
 void add_piece(const LevelMap& levels, int chunk_size, int axis, int side, const glm::ivec3& corner, int q,
-               CellShape& shape) {
+               bool cut_sides, CellShape& shape) {
   const int u = axis_u(axis), v = axis_v(axis);
   // Counter-clockwise seen from outside: u then v on the +axis face, v then u on the -axis face.
   const int first = side ? u : v, second = side ? v : u;
@@ -329,7 +303,7 @@ void add_piece(const LevelMap& levels, int chunk_size, int axis, int side, const
     const glm::ivec3 from = corners[k], to = corners[(k + 1) % 4];
     const int along = from[first] != to[first] ? first : second;
     const int sign = to[along] > from[along] ? 1 : -1;
-    const int step = std::min(q, 1 << line_level(levels, glm::min(from, to), along, chunk_size));
+    const int step = cut_sides ? std::min(q, 1 << line_level(levels, glm::min(from, to), along, chunk_size)) : q;
     for (int t = 0; t < q; t += step) {
       glm::ivec3 n = from;
       n[along] += sign * t;
@@ -342,7 +316,6 @@ void add_piece(const LevelMap& levels, int chunk_size, int axis, int side, const
   centre2[v] += q;
   centre2[axis] += side ? 1 : -1;
   piece.across_doubled = centre2;
-  piece.key = glm::ivec4(axis, corner);
   shape.pieces.push_back(piece);
 }
 
@@ -359,13 +332,7 @@ void build_pieces(const LevelMap& levels, int chunk_size, const Cell& cell, bool
     for (int side = 0; side < 2; ++side) {
       glm::ivec3 across2 = 2 * cell.lo + glm::ivec3(s);
       across2[axis] = side ? 2 * (cell.lo[axis] + s) + 1 : 2 * cell.lo[axis] - 1;
-      if (plain) {
-        glm::ivec3 corner = cell.lo;
-        corner[axis] += side * s;
-        add_square(axis, side, corner, s, across2, shape);
-        continue;
-      }
-      const int q = std::min(s, 1 << levels.at(levels.chunk_of_doubled(across2)));
+      const int q = plain ? s : std::min(s, 1 << levels.at(levels.chunk_of_doubled(across2)));
       const int u = axis_u(axis), v = axis_v(axis);
       for (int i = 0; i < s; i += q)
         for (int j = 0; j < s; j += q) {
@@ -373,19 +340,23 @@ void build_pieces(const LevelMap& levels, int chunk_size, const Cell& cell, bool
           corner[axis] += side * s;
           corner[u] += i;
           corner[v] += j;
-          add_piece(levels, chunk_size, axis, side, corner, q, shape);
+          add_piece(levels, chunk_size, axis, side, corner, q, !plain, shape);
         }
     }
   }
+}
+
+int crossing_index(const CellShape& shape, const glm::ivec3& lower, int axis) {
+  for (size_t i = 0; i < shape.crossings.size(); ++i)
+    if (shape.crossings[i].lower == lower && shape.crossings[i].axis == axis) return int(i);
+  return -1;
 }
 
 int find_or_add_crossing(CellShape& shape, const glm::ivec3& a, const glm::ivec3& b, LevelReader& reader) {
   const glm::ivec3 lower = glm::min(a, b);
   const glm::ivec3 d = glm::abs(b - a);
   const int axis = d.x ? 0 : d.y ? 1 : 2;
-  for (size_t i = 0; i < shape.crossings.size(); ++i) {
-    if (shape.crossings[i].lower == lower && shape.crossings[i].axis == axis) return int(i);
-  }
+  if (const int i = crossing_index(shape, lower, axis); i >= 0) return i;
   CellCrossing c;
   c.lower = lower;
   c.axis = axis;
@@ -444,12 +415,6 @@ void trace_sheets(CellShape& shape, const std::vector<uint8_t>& joined) {
     for (CellCrossing* c = &start; c->sheet < 0; c = &shape.crossings[size_t(c->next)]) c->sheet = shape.sheets;
     ++shape.sheets;
   }
-}
-
-int crossing_index(const CellShape& shape, const glm::ivec3& lower, int axis) {
-  for (size_t i = 0; i < shape.crossings.size(); ++i)
-    if (shape.crossings[i].lower == lower && shape.crossings[i].axis == axis) return int(i);
-  return -1;
 }
 
 // The entering crossings of a piece (one per segment).
@@ -545,7 +510,8 @@ class ChunkMesher {
   // with emit_edges, also the crossing edges it emits.
   void mesh_cell(const Cell& cell, bool emit_edges, ChunkPart& out) {
     if (!default_sheets(cell, shape_)) return;
-    std::vector<uint8_t> joined(shape_.pieces.size(), 0);
+    std::vector<uint8_t>& joined = joined_;
+    joined.assign(shape_.pieces.size(), 0);
     bool any_joined = false;
     for (size_t pi = 0; pi < shape_.pieces.size(); ++pi) {
       piece_segments(shape_, shape_.pieces[pi], segments_);
@@ -574,7 +540,7 @@ class ChunkMesher {
     };
     for (const Region::EdgeRef& e : reader_.focus(level, chunk).crossing_edges()) {
       const glm::ivec3 r = e.node - chunk * n;
-      const glm::ivec3 eu = unit(axis_u(e.axis)), ev = unit(axis_v(e.axis));
+      const glm::ivec3 eu = axis_unit(axis_u(e.axis)), ev = axis_unit(axis_v(e.axis));
       mark_cell(r);
       mark_cell(r - eu);
       mark_cell(r - ev);
@@ -599,8 +565,7 @@ class ChunkMesher {
   // whose neighbours are no finer, and away from the chunk's faces.
   bool is_plain(const Cell& cell) const {
     const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
-    if (chunk != chunk_) return !has_finer_neighbour(chunk, cell.level) &&
-                                levels_->at(chunk) == cell.level;  // a cell across (conflict checks)
+    if (chunk != chunk_) return !has_finer_neighbour(chunk, cell.level);  // a neighbour's cell
     if (!finer_neighbour_) return true;
     const glm::ivec3 r = cell.lo - chunk * chunk_size_;
     return glm::all(glm::greaterThan(r, glm::ivec3(0))) &&
@@ -676,7 +641,7 @@ class ChunkMesher {
   glm::ivec3 chunk_{0};
   bool finer_neighbour_ = false;  // of chunk_
   CellShape shape_, other_;
-  std::vector<uint8_t> no_joins_;
+  std::vector<uint8_t> no_joins_, joined_;
   std::vector<int> segments_;
   std::vector<const CellCrossing*> on_loop_;
 };
@@ -693,9 +658,8 @@ struct PolygonVertex {
 bool split_along_02(const PolygonVertex p[4]) {
   const glm::dvec3 m02 = 0.5 * (p[0].v->x + p[2].v->x), m13 = 0.5 * (p[1].v->x + p[3].v->x);
   auto err = [&](int i, const glm::dvec3& m) { return p[i].v->qef.error(m - glm::dvec3(p[i].v->cell_lo)); };
-  const double e02 = err(0, m02) + err(2, m02), e13 = err(1, m13) + err(3, m13);
-  if (std::abs(e02 - e13) > 1e-9 * (1.0 + e02 + e13)) return e02 < e13;
-  return glm::length(p[0].v->x - p[2].v->x) <= glm::length(p[1].v->x - p[3].v->x);
+  const glm::dvec3 corners[4] = {p[0].v->x, p[1].v->x, p[2].v->x, p[3].v->x};
+  return detail::split_along_02(err(0, m02) + err(2, m02), err(1, m13) + err(3, m13), corners);
 }
 
 // The triangles of one crossing edge, its cells' vertices found by
@@ -863,19 +827,16 @@ bool chunk_is_meshable(const World& world, const glm::ivec3& chunk) {
 
 Result<ContourMesh> mesh_levels(const World& world, const LevelMap& levels, const ContourConfig& config,
                                 Context* ctx, ContourStats& stats) {
-  // The world's chunks and the layer below the box, whose cells straddle its lower faces.
+  // The world's chunks and the layer below the box, x fastest (WorldParts indexes them so).
+  const std::vector<glm::ivec3> chunks = chunks_to_mesh(world);
   const glm::ivec3 first = world.chunk_origin() - 1, dims = world.chunk_dims() + 1;
-  const size_t count = size_t(dims.x) * size_t(dims.y) * size_t(dims.z);
-  auto chunk_at = [&](size_t i) {
-    return first + glm::ivec3(int(i % size_t(dims.x)), int(i / size_t(dims.x) % size_t(dims.y)),
-                              int(i / (size_t(dims.x) * size_t(dims.y))));
-  };
+  const size_t count = chunks.size();
   std::vector<ChunkPart> parts(count);
   tbb::enumerable_thread_specific<ChunkMesher> meshers([&] { return ChunkMesher(&levels, &world, &config); });
   std::atomic<size_t> done{0};
   tbb::parallel_for(size_t{0}, count, [&](size_t i) {
     if (ctx && ctx->cancelled()) return;
-    meshers.local().mesh(chunk_at(i), parts[i]);
+    meshers.local().mesh(chunks[i], parts[i]);
     const size_t n = done.fetch_add(1) + 1;
     if (ctx && n % 16 == 0) ctx->report_progress("contour levels", double(n) / double(2 * count));
   });
@@ -1099,14 +1060,19 @@ std::vector<glm::ivec3> LevelChunkedMesh::near_changes(const World& world, std::
     if (levels[i] != levels_[i]) changed.push_back(c);
   });
   const glm::ivec3 lo = box_.origin - 1, hi = box_.origin + box_.dims;
+  std::vector<glm::ivec3> out = chunks_a_change_reaches(changed);
+  std::erase_if(out, [&](const glm::ivec3& n) {
+    return !glm::all(glm::greaterThanEqual(n, lo)) || !glm::all(glm::lessThan(n, hi));
+  });
+  return out;
+}
+
+std::vector<glm::ivec3> LevelChunkedMesh::chunks_a_change_reaches(std::span<const glm::ivec3> changed) {
   std::set<glm::ivec3, ChunkOrder> out;
   for (const glm::ivec3& c : changed)
     for (int dz = -1; dz <= 1; ++dz)
       for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
-          if (glm::all(glm::greaterThanEqual(n, lo)) && glm::all(glm::lessThan(n, hi))) out.insert(n);
-        }
+        for (int dx = -1; dx <= 1; ++dx) out.insert(c + glm::ivec3(dx, dy, dz));
   return {out.begin(), out.end()};
 }
 

@@ -8,12 +8,6 @@
 namespace ldc::detail {
 namespace {
 
-glm::ivec3 unit(int axis) {
-  glm::ivec3 e(0);
-  e[axis] = 1;
-  return e;
-}
-
 bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
   return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
 }
@@ -63,7 +57,7 @@ uint8_t RegionMesher::sheet_of(const glm::ivec3& cell, int axis, const glm::ivec
 bool RegionMesher::edge_quad(int axis, const glm::ivec3& node, Quad* quad) const {
   const EdgeCrossing* x = region_.crossing(axis, node);
   if (!x) return false;
-  const glm::ivec3 eu = unit(axis_u(axis)), ev = unit(axis_v(axis));
+  const glm::ivec3 eu = axis_unit(axis_u(axis)), ev = axis_unit(axis_v(axis));
   // Counter-clockwise seen from +axis (u x v = axis); reversed when +axis is inside.
   glm::ivec3 cells[4] = {node - eu - ev, node - ev, node, node - eu};
   bool outward_plus = region_.inside(node);
@@ -97,14 +91,7 @@ void RegionMesher::split(const Quad& q, int tri[2][3]) const {
   }
   glm::dvec3 m02 = 0.5 * (p[0] + p[2]), m13 = 0.5 * (p[1] + p[3]);
   auto err = [&](int i, const glm::dvec3& m) { return v[i]->qef.error(m - glm::dvec3(q.cell[i] - frame)); };
-  double e02 = err(0, m02) + err(2, m02);
-  double e13 = err(1, m13) + err(3, m13);
-  bool use02;
-  if (std::abs(e02 - e13) > 1e-9 * (1.0 + e02 + e13)) {
-    use02 = e02 < e13;
-  } else {
-    use02 = glm::length(p[0] - p[2]) <= glm::length(p[1] - p[3]);
-  }
+  const bool use02 = split_along_02(err(0, m02) + err(2, m02), err(1, m13) + err(3, m13), p);
   static const int kDiag02[2][3] = {{0, 1, 2}, {0, 2, 3}};
   static const int kDiag13[2][3] = {{0, 1, 3}, {1, 2, 3}};
   const int(*t)[3] = use02 ? kDiag02 : kDiag13;
@@ -118,7 +105,7 @@ void RegionMesher::mark_cells_with_vertex() {
   std::vector<uint8_t>& marked = marked_;
   marked.assign(size_t(cell_hi_.x - cell_lo_.x) * (cell_hi_.y - cell_lo_.y) * (cell_hi_.z - cell_lo_.z), 0);
   for (const Region::EdgeRef& e : region_.crossing_edges()) {
-    const glm::ivec3 eu = unit(axis_u(e.axis)), ev = unit(axis_v(e.axis));
+    const glm::ivec3 eu = axis_unit(axis_u(e.axis)), ev = axis_unit(axis_v(e.axis));
     for (int k = 0; k < 4; ++k) {
       glm::ivec3 cell = e.node - ((k & 1) ? eu : glm::ivec3(0)) - ((k & 2) ? ev : glm::ivec3(0));
       if (glm::all(glm::greaterThanEqual(cell, cell_lo_)) && glm::all(glm::lessThan(cell, cell_hi_))) {

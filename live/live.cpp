@@ -66,14 +66,22 @@ struct LiveState {
     remeshed_since_update += u.chunks_remeshed;
   }
 
-  // Every chunk mesh of `old` reported removed and every one of the new
-  // meshes reported changed: what an engine sees when meshing restarts.
-  void note_rebuild(const ChunkedMesh* old, const ChunkedMesh* now) {
-    if (old) {
-      for (const ChunkMesh& m : old->chunks()) mesh_changes[m.chunk] = {m.chunk, 0};
+  // Every chunk mesh held now (of either kind) reported removed, and every
+  // one of the new meshes reported changed: what an engine sees when
+  // meshing restarts (or stops, with none).
+  void note_rebuild(const ChunkedMesh* now_uniform, const LevelChunkedMesh* now_levels) {
+    if (meshes) {
+      for (const ChunkMesh& m : meshes->chunks()) mesh_changes[m.chunk] = {m.chunk, 0};
     }
-    if (now) {
-      for (const ChunkMesh& m : now->chunks()) mesh_changes[m.chunk] = {m.chunk, m.version};
+    if (level_meshes) {
+      for (const ChunkMesh* m : level_meshes->chunks()) mesh_changes[m->chunk] = {m->chunk, 0};
+    }
+    if (now_uniform) {
+      for (const ChunkMesh& m : now_uniform->chunks()) mesh_changes[m.chunk] = {m.chunk, m.version};
+    }
+    if (now_levels) {
+      for (const ChunkMesh* m : now_levels->chunks())
+        mesh_changes[m->chunk] = {m->chunk, m->version, now_levels->level(m->chunk)};
     }
   }
 
@@ -104,12 +112,9 @@ struct LiveState {
   // The chunks whose meshes a change of `dirty` may change.
   std::vector<glm::ivec3> mesh_chunks_of(std::span<const DirtyChunk> dirty) const {
     if (!config.lod) return chunks_a_remesh_may_change(dirty, config.contour, world().chunk_size());
-    std::set<glm::ivec3, ChunkOrder> out;  // LevelChunkedMesh: the 26 neighbours
-    for (const DirtyChunk& d : dirty)
-      for (int dz = -1; dz <= 1; ++dz)
-        for (int dy = -1; dy <= 1; ++dy)
-          for (int dx = -1; dx <= 1; ++dx) out.insert(d.chunk + glm::ivec3(dx, dy, dz));
-    return {out.begin(), out.end()};
+    std::vector<glm::ivec3> chunks;
+    for (const DirtyChunk& d : dirty) chunks.push_back(d.chunk);
+    return LevelChunkedMesh::chunks_a_change_reaches(chunks);
   }
 
   void record_mesh_flags(std::span<const DirtyChunk> dirty) {
@@ -273,14 +278,9 @@ size_t LiveWorld::pending_changes() const { return state_->changes.size(); }
 Status LiveWorld::enable_meshes(const ContourConfig& config, Context* ctx) {
   detail::LiveState& s = *state_;
   if (s.config.lod) {
-    if (Status st = check_contour_config(config); !st.ok()) return st;
     LevelChunkedMesh built(config);
     if (Status st = built.build(s.world(), s.level_of(), ctx); !st.ok()) return st;
-    s.note_rebuild(s.meshes ? &*s.meshes : nullptr, nullptr);
-    if (s.level_meshes) {
-      for (const ChunkMesh* m : s.level_meshes->chunks()) s.mesh_changes[m->chunk] = {m->chunk, 0};
-    }
-    for (const ChunkMesh* m : built.chunks()) s.mesh_changes[m->chunk] = {m->chunk, m->version, built.level(m->chunk)};
+    s.note_rebuild(nullptr, &built);
     s.meshes.reset();
     s.level_meshes.emplace(std::move(built));
     s.mesh_pending.clear();
@@ -291,7 +291,8 @@ Status LiveWorld::enable_meshes(const ContourConfig& config, Context* ctx) {
   }
   Result<ChunkedMesh> built = ChunkedMesh::create(s.world(), config, ctx);
   if (!built) return built.status();
-  s.note_rebuild(s.meshes ? &*s.meshes : nullptr, &*built);
+  s.note_rebuild(&*built, nullptr);
+  s.level_meshes.reset();
   s.meshes.emplace(std::move(built).value());
   s.mesh_pending.clear();
   s.config.contour = config;
@@ -301,10 +302,7 @@ Status LiveWorld::enable_meshes(const ContourConfig& config, Context* ctx) {
 
 void LiveWorld::disable_meshes() {
   detail::LiveState& s = *state_;
-  if (s.meshes) s.note_rebuild(&*s.meshes, nullptr);
-  if (s.level_meshes) {
-    for (const ChunkMesh* m : s.level_meshes->chunks()) s.mesh_changes[m->chunk] = {m->chunk, 0};
-  }
+  s.note_rebuild(nullptr, nullptr);
   s.meshes.reset();
   s.level_meshes.reset();
   s.mesh_pending.clear();

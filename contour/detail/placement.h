@@ -1,6 +1,7 @@
 // Vertex placement from the Hermite planes of a cell.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 
 #include <glm/glm.hpp>
@@ -45,6 +46,15 @@ struct PlacedVertex {
   int rank = 3;              // kQef: eigenvalues kept
   bool clamped = false;      // the cell bound moved it
 };
+
+// The meshers' quad split rule: along corners 0-2 when that diagonal's
+// midpoint fits the Hermite planes of its two end cells better (e02 < e13,
+// each the summed QEF error at its diagonal's midpoint); ties, to within
+// rounding, go to the shorter diagonal. p: the quad's corners.
+inline bool split_along_02(double e02, double e13, const glm::dvec3 p[4]) {
+  if (std::abs(e02 - e13) > 1e-9 * (1.0 + e02 + e13)) return e02 < e13;
+  return glm::length(p[0] - p[2]) <= glm::length(p[1] - p[3]);
+}
 
 // Places the vertex of the cell [cell_min, cell_min + 1]^3.
 // `qef` is Qef::of(planes), computed once by the caller.

@@ -13,6 +13,13 @@
 
 namespace ldc::detail {
 
+// The unit lattice step along `axis`.
+inline glm::ivec3 axis_unit(int axis) {
+  glm::ivec3 e(0);
+  e[axis] = 1;
+  return e;
+}
+
 struct EdgeCrossing {
   float t = 0.0f;           // position along the edge from its lower node, in (0, 1)
   glm::vec3 normal{0.0f};   // unit, out of the solid

@@ -47,6 +47,7 @@
 #include <mutex>
 #include <optional>
 #include <set>
+#include <span>
 #include <string>
 #include <thread>
 #include <utility>
@@ -423,10 +424,8 @@ bool wants_mesh(const Session& s, const glm::ivec3& c) {
 // Whether c is within one chunk of a chunk the batch changed: a chunk's mesh
 // reads the rays and levels of its 26 neighbours (contour_chunk_levels).
 bool near_change(const Batch& b, const glm::ivec3& c) {
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx)
-        if (b.changed.count(key(c + glm::ivec3(dx, dy, dz)))) return true;
+  for (const glm::ivec3& n : ldc::LevelChunkedMesh::chunks_a_change_reaches(std::span(&c, 1)))
+    if (b.changed.count(key(n))) return true;
   return false;
 }
 
@@ -435,14 +434,11 @@ bool near_change(const Batch& b, const glm::ivec3& c) {
 void add_change(Session& s, const glm::ivec3& c, const LevelsPtr& levels) {
   if (!s.batch) s.batch = Batch{levels, {}, {}, {}};
   s.batch->changed.insert(key(c));
-  for (int dz = -1; dz <= 1; ++dz)
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const glm::ivec3 n = c + glm::ivec3(dx, dy, dz);
-        if (!wants_mesh(s, n)) continue;
-        s.batch->chunks.insert(key(n));
-        s.batch->staged.erase(key(n));  // made before this change
-      }
+  for (const glm::ivec3& n : ldc::LevelChunkedMesh::chunks_a_change_reaches(std::span(&c, 1))) {
+    if (!wants_mesh(s, n)) continue;
+    s.batch->chunks.insert(key(n));
+    s.batch->staged.erase(key(n));  // made before this change
+  }
   s.queue_stale = true;
 }
 
