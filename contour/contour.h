@@ -309,6 +309,48 @@ Result<ChunkMesh> contour_chunk_levels(const World& world, const glm::ivec3& chu
                                        const std::function<int(const glm::ivec3&)>& level_of_chunk,
                                        const ContourConfig& config = {}, ContourStats* stats = nullptr);
 
+// --- Levels the surface allows (adaptive output) ---------------------------------
+//
+// Each chunk's coarsest level k (at most max_level, and max_lod_level(C))
+// at which meshing it from every 2^k-th ray keeps its surface: in every
+// level-k cell of the chunk, each level-0 crossing lies within `tolerance`
+// (cells of h) of the Hermite plane of a crossing of the same material on
+// that cell's own edges, and no level-k edge of the chunk holds several
+// crossings or a crossing its ends' signs do not show. Flat faces and the
+// creases and corners between them go coarse; curvature whose sag over a
+// level-k cell passes the tolerance, detail thinner or smaller than the cell
+// and material borders that do not line up stay finer. Chunks with no
+// surface get max_level. Feed the result to contour_levels, then
+// simplify_mesh: the simplifier then starts from far fewer triangles where
+// the surface is plain (see docs/contour.md for the figures). Parallel over
+// chunks; the same levels for any thread count. Errors: kInvalidArgument for
+// a negative or non-finite tolerance or a negative max_level; kCancelled
+// through ctx. Stage timer "surface_levels".
+struct SurfaceLevelOptions {
+  double tolerance = 0.02;  // [Units: cells of h] [Limit: >= 0]
+  int max_level = 2;        // [Limit: >= 0; capped at max_lod_level(C)]
+};
+
+// A level for every chunk of a world's box.
+struct ChunkLevels {
+  glm::ivec3 first{0}, dims{0};  // the box's chunks, as World::chunk_origin / chunk_dims
+  std::vector<uint8_t> level;    // x fastest
+  std::vector<uint8_t> surface;  // 1 where the chunk's level-0 lattice has a crossing
+  // The level of `chunk`, clamped into the box (0 when empty): a level_of_chunk for contour_levels.
+  int operator()(const glm::ivec3& chunk) const;
+  size_t surface_chunks(int k) const;  // chunks with surface at level k
+};
+
+Result<ChunkLevels> surface_levels(const World& world, const SurfaceLevelOptions& options = {},
+                                   Context* ctx = nullptr);
+
+// Whether contour_levels at `levels` then simplify_mesh is expected to be
+// faster than contour_world then simplify_mesh (a cost model of the chunks
+// with surface at each level; see surface_levels.cpp). The outputs of both
+// ways are closed 2-manifolds; only the time and, within the tolerance, the
+// surface differ.
+bool surface_levels_pay_off(const ChunkLevels& levels);
+
 // Chunk meshes at levels of detail, kept up to date: what ChunkedMesh is to
 // contour_chunk, for contour_chunk_levels. Holds every chunk's mesh at its
 // level (chunks the world's box holds, and the layer below it; chunks with

@@ -2,14 +2,17 @@
 
 #include <cmath>
 #include <cstdio>
+#include <optional>
 
+#include "ldc/lod.h"
 #include "meshio/meshio.h"
 #include "plugin.h"
 
 namespace ldc::tool {
 namespace {
 
-Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats* stats) {
+Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, const std::optional<ChunkLevels>& levels,
+                               Context* ctx, ContourStats* stats) {
   if (a.method == "mc" && a.level_of_chunk) {
     return Status(ErrorCode::kInvalidArgument, "--method mc has no levels of detail: leave out --lod-bands");
   }
@@ -26,7 +29,26 @@ Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, Context*
   // the contouring time.
   c.untangle = false;
   if (a.level_of_chunk) return contour_levels(w, a.level_of_chunk, c, ctx, stats);
+  if (levels) return contour_levels(w, *levels, c, ctx, stats);
   return contour_world(w, c, ctx, stats);
+}
+
+// Adaptive output: the chunks' levels by surface_levels, at a tenth of the
+// bound, kept when the cost model says they pay off (report["surface_levels"]).
+Result<std::optional<ChunkLevels>> choose_levels(const World& w, const MeshOutputArgs& a, Context* ctx,
+                                                 nlohmann::json& report) {
+  if (!a.surface_levels || a.max_error_cells <= 0.0 || a.method == "mc" || a.level_of_chunk) return std::optional<ChunkLevels>();
+  ScopedTimer t(nullptr, "");
+  const SurfaceLevelOptions options{.tolerance = a.max_error_cells / 10.0};
+  Result<ChunkLevels> levels = surface_levels(w, options, ctx);
+  if (!levels.ok()) return levels.status();
+  const bool used = surface_levels_pay_off(levels.value());
+  nlohmann::json chunks = nlohmann::json::array();
+  for (int k = 0; k <= max_lod_level(w.chunk_size()); ++k) chunks.push_back(levels.value().surface_chunks(k));
+  report["surface_levels"] = {{"tolerance_cells", options.tolerance}, {"chunks_by_level", chunks}, {"used", used}};
+  report["seconds"]["surface_levels"] = t.seconds();
+  if (!used) return std::optional<ChunkLevels>();
+  return std::optional<ChunkLevels>(std::move(levels.value()));
 }
 
 ExportOptions export_options(const World& w) {
@@ -131,8 +153,10 @@ Status simplify_and_untangle_output(const World& w, const MeshOutputArgs& a, Con
 // contouring with untangling on), timing each step.
 Result<ContourMesh> mesh_world(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats& stats,
                                nlohmann::json& report) {
+  Result<std::optional<ChunkLevels>> levels = choose_levels(w, a, ctx, report);
+  if (!levels.ok()) return levels.status();
   ScopedTimer t(nullptr, "");
-  Result<ContourMesh> mesh = run_method(w, a, ctx, &stats);
+  Result<ContourMesh> mesh = run_method(w, a, levels.value(), ctx, &stats);
   report["seconds"]["contour"] = t.seconds();
   if (!mesh.ok()) return mesh;
   const bool untangle = a.method != "mc" && a.config.untangle;
@@ -163,6 +187,13 @@ void print_report(const nlohmann::json& j) {
     std::printf("  adaptive: %zu -> %zu triangles within %g cells (%g m); %zu collapses\n",
                 s["triangles_before"].get<size_t>(), s["triangles_after"].get<size_t>(),
                 s["max_error_cells"].get<double>(), s["max_error"].get<double>(), s["collapses"].get<size_t>());
+  }
+  if (j.contains("surface_levels")) {
+    const auto& l = j["surface_levels"];
+    std::string counts;
+    for (const auto& n : l["chunks_by_level"]) counts += (counts.empty() ? "" : " / ") + std::to_string(n.get<size_t>());
+    std::printf("  surface levels: chunks with surface at level 0 / 1 / ...: %s (%s)\n", counts.c_str(),
+                l["used"].get<bool>() ? "meshed at these levels" : "one level: the levels would not pay off");
   }
   if (j.contains("untangle") && j["untangle"]["pairs_before"].get<size_t>() > 0) {
     const auto& u = j["untangle"];
@@ -207,6 +238,9 @@ void add_mesh_output_options(CLI::App* cmd, MeshOutputArgs& a) {
   cmd->add_option("--max-error", a.max_error_cells,
                   "Adaptive output: simplify within this distance, in cells of h (0 = uniform output)")
       ->capture_default_str();
+  cmd->add_flag("--surface-levels,!--no-surface-levels", a.surface_levels,
+                "Adaptive output: mesh chunks whose surface is plain (flat faces, creases) from every 2nd or 4th ray "
+                "before simplifying, when the cost model says it is faster (default on; off: one level everywhere)");
   cmd->add_option("--target-triangles", a.target_triangles,
                   "Adaptive output: stop simplifying at this many triangles (0 = no target; the bound still holds)")
       ->capture_default_str();

@@ -26,6 +26,9 @@ struct MeshOutputArgs {
   // before add_mesh_output_options.
   double max_error_cells = 0.0;
   size_t target_triangles = 0;
+  // Adaptive output: chunks meshed at the levels surface_levels allows
+  // (contour_levels) where surface_levels_pay_off says it is faster.
+  bool surface_levels = true;
   // Set: each chunk meshed at its own level (contour_levels), not with `method`'s placement only.
   std::function<int(const glm::ivec3&)> level_of_chunk;
 };
