@@ -546,11 +546,19 @@ class ChunkMesher {
       mark_cell(r - ev);
       mark_cell(r - eu - ev);
     }
-    if (finer_neighbour_) {
-      for (int z = 0; z < n; ++z)
-        for (int y = 0; y < n; ++y)
-          for (int x = 0; x < n; ++x)
-            if (x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1) mark_cell({x, y, z});
+    if (finer_neighbour_) {  // the cells touching a finer chunk: its cut faces may hold more
+      for (int dz = -1; dz <= 1; ++dz)
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx) {
+            const glm::ivec3 d(dx, dy, dz);
+            if (d == glm::ivec3(0) || levels_->at(chunk + d) >= level) continue;
+            glm::ivec3 lo(0), hi(n - 1);  // the layer, line or corner of cells beside that neighbour
+            for (int k = 0; k < 3; ++k)
+              if (d[k] != 0) lo[k] = hi[k] = d[k] < 0 ? 0 : n - 1;
+            for (int z = lo.z; z <= hi.z; ++z)
+              for (int y = lo.y; y <= hi.y; ++y)
+                for (int x = lo.x; x <= hi.x; ++x) mark_cell({x, y, z});
+          }
     }
     std::vector<Cell> cells;
     for (int z = 0; z < n; ++z)
@@ -565,11 +573,20 @@ class ChunkMesher {
   // whose neighbours are no finer, and away from the chunk's faces.
   bool is_plain(const Cell& cell) const {
     const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
-    if (chunk != chunk_) return !has_finer_neighbour(chunk, cell.level);  // a neighbour's cell
-    if (!finer_neighbour_) return true;
+    if (chunk == chunk_ && !finer_neighbour_) return true;
+    // The chunks whose closed boxes the cell's closed box touches: its own,
+    // and across each chunk face, edge or corner it lies on.
     const glm::ivec3 r = cell.lo - chunk * chunk_size_;
-    return glm::all(glm::greaterThan(r, glm::ivec3(0))) &&
-           glm::all(glm::lessThan(r + cell.size(), glm::ivec3(chunk_size_)));
+    glm::ivec3 lo(0), hi(0);
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = r[k] == 0 ? -1 : 0;
+      hi[k] = r[k] + cell.size() == chunk_size_ ? 1 : 0;
+    }
+    for (int dz = lo.z; dz <= hi.z; ++dz)
+      for (int dy = lo.y; dy <= hi.y; ++dy)
+        for (int dx = lo.x; dx <= hi.x; ++dx)
+          if (levels_->at(chunk + glm::ivec3(dx, dy, dz)) < cell.level) return false;
+    return true;
   }
 
   bool has_finer_neighbour(const glm::ivec3& chunk, int level) const {
