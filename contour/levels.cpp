@@ -174,7 +174,7 @@ class LevelReader {
   bool in_focus(const glm::ivec3& node) const {
     const unsigned mask = (1u << focus_level_) - 1u;
     return focus_level_ >= 0 && ((unsigned(node.x) | unsigned(node.y) | unsigned(node.z)) & mask) == 0 &&
-           glm::all(glm::greaterThanEqual(node, focus_lo_)) && glm::all(glm::lessThanEqual(node, focus_hi_));
+           detail::in_box(node, focus_lo_, focus_hi_ + 1);
   }
   int chunk_shift(int level) const { return world_->chunk_shift() - level; }
 
@@ -535,7 +535,7 @@ class ChunkMesher {
     const int level = levels_->at(chunk), s = 1 << level, n = chunk_size_ >> level;
     std::vector<uint8_t> mark(size_t(n) * size_t(n) * size_t(n), 0);
     auto mark_cell = [&](const glm::ivec3& c) {  // c in level-`level` cells, relative to the chunk
-      if (glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n))))
+      if (detail::in_box(c, glm::ivec3(0), glm::ivec3(n)))
         mark[(size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x)] = 1;
     };
     for (const Region::EdgeRef& e : reader_.focus(level, chunk).crossing_edges()) {
@@ -644,7 +644,7 @@ class ChunkMesher {
     for (const CellCrossing& c : shape_.crossings) {
       for (int q = 0; q < 4; ++q) {
         const glm::ivec3 p = quadrant_point(c.lower, c.axis, c.level, q);
-        if (!glm::all(glm::greaterThan(p, lo2)) || !glm::all(glm::lessThan(p, hi2))) continue;
+        if (!detail::in_box(p, lo2 + 1, hi2)) continue;
         out.keys.emplace_back(quadrant_key(c.lower, c.axis, q, chunk, chunk_size_), first_vertex + uint32_t(c.sheet));
         if (q == 2 && emit_edges) out.edges.push_back({c.lower, c.axis, c.level, reader_.inside(c.lower), c.x->material});
       }

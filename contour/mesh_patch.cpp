@@ -25,10 +25,6 @@ bool vertex_less(const glm::ivec3& a, uint8_t sa, const glm::ivec3& b, uint8_t s
   return a != b ? cell_less(a, b) : sa < sb;
 }
 
-bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
-  return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
-}
-
 // The edge a quad triangle came from: its three cells share the coordinate
 // along the edge's axis, and the edge's node is their largest corner.
 glm::ivec3 edge_node(const glm::ivec3 (&cell)[3]) {

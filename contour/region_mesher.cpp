@@ -6,18 +6,11 @@
 #include <meshoptimizer.h>
 
 namespace ldc::detail {
-namespace {
-
-bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
-  return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
-}
-
-}  // namespace
 
 void optimize_triangle_order(ContourMesh& m);
 
 bool RegionMesher::in_cell_box(const glm::ivec3& cell) const {
-  return glm::all(glm::greaterThanEqual(cell, cell_lo_)) && glm::all(glm::lessThan(cell, cell_hi_));
+  return in_box(cell, cell_lo_, cell_hi_);
 }
 
 size_t RegionMesher::cell_index(const glm::ivec3& cell) const {

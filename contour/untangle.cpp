@@ -33,10 +33,6 @@ namespace {
 // Eigenvalue cut-off (relative to the largest) for a corner: the one kQef uses.
 constexpr double kCornerRank = 0.1;
 
-bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
-  return glm::all(glm::greaterThanEqual(p, lo)) && glm::all(glm::lessThan(p, hi));
-}
-
 struct Box {
   glm::dvec3 lo, hi;
 };

@@ -20,6 +20,12 @@ inline glm::ivec3 axis_unit(int axis) {
   return e;
 }
 
+// lo <= p < hi in every coordinate (written out: glm's vector compares
+// were left as calls in the meshers' inner loops).
+inline bool in_box(const glm::ivec3& p, const glm::ivec3& lo, const glm::ivec3& hi) {
+  return p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x < hi.x && p.y < hi.y && p.z < hi.z;
+}
+
 struct EdgeCrossing {
   float t = 0.0f;           // position along the edge from its lower node, in (0, 1)
   glm::vec3 normal{0.0f};   // unit, out of the solid
@@ -40,7 +46,7 @@ class Region {
   glm::ivec3 lo() const { return lo_; }
   glm::ivec3 hi() const { return hi_; }
   bool contains(const glm::ivec3& node) const {
-    return glm::all(glm::greaterThanEqual(node, lo_)) && glm::all(glm::lessThan(node, hi_));
+    return in_box(node, lo_, hi_);
   }
   size_t index(const glm::ivec3& node) const {
     glm::ivec3 r = node - lo_;
@@ -106,7 +112,7 @@ class Region {
                    const RayPoint* first, const RayPoint* last, int count);
 
   bool counted(const glm::ivec3& node) const {
-    return glm::all(glm::greaterThanEqual(node, count_lo_)) && glm::all(glm::lessThan(node, count_hi_));
+    return in_box(node, count_lo_, count_hi_);
   }
 
   glm::ivec3 lo_{0}, hi_{0}, size_{0}, count_lo_{0}, count_hi_{0};
