@@ -391,7 +391,8 @@ double ldc_phase(const std::string& text, const std::string& phase) {
 }
 
 void print_ldc_phases(const std::vector<Row>& rows) {
-  const std::vector<std::string> phases = {"load", "build_boolean", "contour", "simplify", "untangle", "quality", "export"};
+  const std::vector<std::string> phases = {"load",     "build_boolean", "surface_levels", "contour",
+                                           "simplify", "untangle",      "quality",        "export"};
   std::printf("\n### Phases `ldc boolean` reports (s, of the best run; rest = the process outside them: start-up, "
               "exit, anything not timed)\n\n");
   std::printf("| case | op | ldc | cells | whole process |");

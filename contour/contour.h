@@ -336,6 +336,8 @@ struct ChunkLevels {
   glm::ivec3 first{0}, dims{0};  // the box's chunks, as World::chunk_origin / chunk_dims
   std::vector<uint8_t> level;    // x fastest
   std::vector<uint8_t> surface;  // 1 where the chunk's level-0 lattice has a crossing
+  // A chunk's surface holds several materials (contour_levels does not relax material borders).
+  bool several_materials = false;
   // The level of `chunk`, clamped into the box (0 when empty): a level_of_chunk for contour_levels.
   int operator()(const glm::ivec3& chunk) const;
   size_t surface_chunks(int k) const;  // chunks with surface at level k

@@ -84,6 +84,15 @@ bool no_enclosed_part(const Region& fine, const Region& coarse, const glm::ivec3
   return true;
 }
 
+bool several_materials(const Region& fine) {
+  const std::vector<Region::EdgeRef>& edges = fine.crossing_edges();
+  if (edges.empty()) return false;
+  const uint16_t first = fine.crossing(edges[0].axis, edges[0].node)->material;
+  for (const Region::EdgeRef& e : edges)
+    if (fine.crossing(e.axis, e.node)->material != first) return true;
+  return false;
+}
+
 // Whether level k keeps chunk `chunk`'s surface within `tolerance` cells
 // (r.fine holds the chunk's level-0 lattice, not uniform). Each level-0
 // crossing must lie near a plane of its coarse cell's own crossings; in a
@@ -147,7 +156,7 @@ Result<ChunkLevels> surface_levels(const World& world, const SurfaceLevelOptions
   out.level.assign(count, 0);
   out.surface.assign(count, 0);
   tbb::enumerable_thread_specific<ChunkReader> readers;
-  std::atomic<bool> stop{false};
+  std::atomic<bool> stop{false}, mixed{false};
   tbb::parallel_for(tbb::blocked_range<size_t>(0, count), [&](const tbb::blocked_range<size_t>& range) {
     ChunkReader& reader = readers.local();
     for (size_t i = range.begin(); i != range.end(); ++i) {
@@ -162,12 +171,14 @@ Result<ChunkLevels> surface_levels(const World& world, const SurfaceLevelOptions
         continue;
       }
       out.surface[i] = 1;
+      if (several_materials(reader.fine)) mixed.store(true, std::memory_order_relaxed);
       int k = 0;
       while (k < top && level_keeps_surface(world, chunk, k + 1, options.tolerance, reader)) ++k;
       out.level[i] = uint8_t(k);
     }
   });
   if (stop.load()) return Status(ErrorCode::kCancelled, "surface_levels: cancelled");
+  out.several_materials = mixed.load();
   return out;
 }
 

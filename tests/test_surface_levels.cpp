@@ -118,6 +118,24 @@ TEST(SurfaceLevels, TheSameLevelsForAnyThreadCount) {
   EXPECT_TRUE(q.closed()) << quality_failures(q);
 }
 
+// A slab whose top is material 1 for x > 0.5 m and 0 elsewhere.
+class TwoMaterialSlab final : public ImplicitSolid {
+ public:
+  double value(const glm::dvec3& p) const override {
+    return std::max({0.05 - p.x, p.x - 0.9, 0.05 - p.y, p.y - 0.9, 0.05 - p.z, p.z - 0.3});
+  }
+  uint16_t material(const glm::dvec3& p) const override { return p.x > 0.5 ? 1 : 0; }
+  WorldBox bounds() const override { return {{0.05, 0.05, 0.05}, {0.9, 0.9, 0.3}}; }
+};
+
+// contour_levels leaves material borders unrelaxed, so callers need to know.
+TEST(SurfaceLevels, SaysWhenTheSurfaceHoldsSeveralMaterials) {
+  GridConfig g = test::lattice_at_origin(kH);
+  g.chunk_size = 32;
+  EXPECT_TRUE(surface_levels(build_from_implicit(TwoMaterialSlab(), g).value()).value().several_materials);
+  EXPECT_FALSE(surface_levels(build(turned_cube(glm::dvec3(0.5), 0.7))).value().several_materials);
+}
+
 TEST(SurfaceLevels, ChunksWithoutSurfaceTakeTheTopLevel) {
   const World w = build(test::box_mesh({0.1, 0.1, 0.1}, {0.2, 0.2, 0.2}));
   const ChunkLevels l = surface_levels(w, {.max_level = 1}).value();

@@ -42,10 +42,16 @@ Result<std::optional<ChunkLevels>> choose_levels(const World& w, const MeshOutpu
   const SurfaceLevelOptions options{.tolerance = a.max_error_cells / 10.0};
   Result<ChunkLevels> levels = surface_levels(w, options, ctx);
   if (!levels.ok()) return levels.status();
-  const bool used = surface_levels_pay_off(levels.value());
+  // contour_levels leaves material borders unrelaxed: keep one level where relaxing was asked for.
+  const bool relaxes = levels.value().several_materials && a.config.relax_iterations > 0;
+  const bool used = !relaxes && surface_levels_pay_off(levels.value());
   nlohmann::json chunks = nlohmann::json::array();
   for (int k = 0; k <= max_lod_level(w.chunk_size()); ++k) chunks.push_back(levels.value().surface_chunks(k));
-  report["surface_levels"] = {{"tolerance_cells", options.tolerance}, {"chunks_by_level", chunks}, {"used", used}};
+  report["surface_levels"] = {{"tolerance_cells", options.tolerance},
+                               {"chunks_by_level", chunks},
+                               {"several_materials", levels.value().several_materials},
+                               {"borders_relaxed", relaxes},
+                               {"used", used}};
   report["seconds"]["surface_levels"] = t.seconds();
   if (!used) return std::optional<ChunkLevels>();
   return std::optional<ChunkLevels>(std::move(levels.value()));
@@ -192,8 +198,10 @@ void print_report(const nlohmann::json& j) {
     const auto& l = j["surface_levels"];
     std::string counts;
     for (const auto& n : l["chunks_by_level"]) counts += (counts.empty() ? "" : " / ") + std::to_string(n.get<size_t>());
-    std::printf("  surface levels: chunks with surface at level 0 / 1 / ...: %s (%s)\n", counts.c_str(),
-                l["used"].get<bool>() ? "meshed at these levels" : "one level: the levels would not pay off");
+    const char* why = l["used"].get<bool>()                ? "meshed at these levels"
+                      : l["borders_relaxed"].get<bool>()   ? "one level: material borders are relaxed there"
+                                                           : "one level: the levels would not pay off";
+    std::printf("  surface levels: chunks with surface at level 0 / 1 / ...: %s (%s)\n", counts.c_str(), why);
   }
   if (j.contains("untangle") && j["untangle"]["pairs_before"].get<size_t>() > 0) {
     const auto& u = j["untangle"];
