@@ -292,7 +292,7 @@ void print_adaptive_rows(const std::vector<AdaptiveRow>& rows) {
   std::printf("\n### Adaptive remesh: `ldc remesh` (default --max-error %.1f cells) against OpenVDB volumeToMesh with "
               "adaptivity (h = diagonal / N)\n\n",
               kRemeshMaxErrorCells);
-  std::printf("| mesh | method | N | adaptivity | ms 2t (1 run) | tris | ldc uniform tris | mean rel | Haus rel | "
+  std::printf("| mesh | method | N | adaptivity | ms 2t (1 run) | tris | ldc tris before simplifying | mean rel | Haus rel | "
               "near-sharp normal deg | closed (welded) | self-intersecting pairs | on OpenVDB front |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const AdaptiveRow& r : rows) {
@@ -422,8 +422,10 @@ void print_adaptive_notes(const std::vector<AdaptiveRow>& rows) {
   std::printf(
       "\nNotes: ldc rows are the remesh as `ldc remesh` runs it by default (tools/mesh_output.cpp, mesh_world): "
       "build_from_mesh at h = diagonal / N (the tool's default grid is --cells along the longest axis instead), "
-      "contour_world with iterative placement and without the local untangling round, simplify_mesh within %.1f h "
-      "(the default --max-error), then untangle_mesh; \"ldc uniform tris\" is the count before simplify_mesh. "
+      "surface_levels at a tenth of the bound and, where surface_levels_pay_off says so, contour_levels at those "
+      "levels (otherwise contour_world), with iterative placement and without the local untangling round, "
+      "simplify_mesh within %.1f h (the default --max-error), then untangle_mesh; \"ldc tris before simplifying\" "
+      "is the count before simplify_mesh (the uniform mesh where one level was kept). "
       "OpenVDB rows: meshToLevelSet (half width 3 voxels) at h = diagonal / N, then volumeToMesh(isovalue 0, "
       "adaptivity) with relaxDisorientedTriangles on (the default), quads split into two triangles and re-wound "
       "outward, at the N listed above (by default N, 2N and 4N of every ldc N; one front per mesh from all of them). Errors from bench/meshdist (200k samples per surface, "
