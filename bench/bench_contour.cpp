@@ -20,7 +20,6 @@
 #include <cstdio>
 #include <functional>
 #include <map>
-#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -52,9 +51,8 @@ struct Method {
 constexpr double kRemeshMaxErrorCells = 0.2;
 
 // As `ldc remesh --max-error <max_error_cells>` does it (tools/mesh_output.cpp,
-// mesh_world): when max_error_cells > 0, the chunks' levels by
-// surface_levels at a tenth of the bound, used where surface_levels_pay_off
-// says so (contour_levels; otherwise contour_world); dual contouring without
+// mesh_world): when max_error_cells > 0, contour_at_surface_levels at a
+// tenth of the bound (otherwise contour_world); dual contouring without
 // the local untangling round, then simplify_mesh within max_error_cells * h
 // when that is > 0, then untangle_mesh on the whole mesh (all timed
 // together). `stats`, when given, receives the simplification's figures.
@@ -65,12 +63,9 @@ ldc::TriangleMesh ldc_remesh(const ldc::TriangleMesh& in, double h, ldc::Contour
   ldc::World w = ldc::build_from_mesh(in, grid).value();
   if (mc) return ldc::to_triangle_mesh(ldc::marching_cubes(w).value());
   config.untangle = false;
-  std::optional<ldc::ChunkLevels> levels;
-  if (max_error_cells > 0.0) {
-    ldc::ChunkLevels l = ldc::surface_levels(w, {.tolerance = max_error_cells / 10.0}).value();
-    if (ldc::surface_levels_pay_off(l)) levels = std::move(l);
-  }
-  ldc::ContourMesh m = levels ? ldc::contour_levels(w, *levels, config).value() : ldc::contour_world(w, config).value();
+  ldc::ContourMesh m = max_error_cells > 0.0
+                           ? ldc::contour_at_surface_levels(w, max_error_cells / 10.0, config).value()
+                           : ldc::contour_world(w, config).value();
   if (max_error_cells > 0.0) {
     ldc::SimplifyStats s =
         ldc::simplify_mesh(m, {.max_error = max_error_cells * w.lattice().cell_size}).value();

@@ -33,9 +33,8 @@ namespace {
 
 using detail::EdgeCrossing;
 using detail::Region;
-using detail::axis_unit;
 
-// The level-0 and level-k lattices of one chunk, read once per thread.
+// The level-0 and level-k lattices of one chunk, kept per thread (their buffers are reused).
 struct ChunkReader {
   Region fine, coarse;
 };
@@ -200,6 +199,31 @@ bool surface_levels_pay_off(const ChunkLevels& levels) {
     by_levels += (kLevelsMeshing + kSimplify) / double(1 << (2 * levels.level[i]));
   }
   return one_level > 0.0 && by_levels < kPayOff * one_level;
+}
+
+Result<ContourMesh> contour_at_surface_levels(const World& world, double tolerance, const ContourConfig& config,
+                                              Context* ctx, ContourStats* stats, SurfaceLevelChoice* choice) {
+  SurfaceLevelChoice local;
+  SurfaceLevelChoice& c = choice ? *choice : local;
+  c = SurfaceLevelChoice();
+  ScopedTimer timer(nullptr, "");
+  Result<ChunkLevels> levels = surface_levels(world, {.tolerance = tolerance}, ctx);
+  if (!levels.ok()) return levels.status();
+  c.levels = std::move(levels.value());
+  c.levels_seconds = timer.seconds();
+  const bool relaxes = c.levels.several_materials && config.relax_iterations > 0;
+  if (!relaxes && surface_levels_pay_off(c.levels)) {
+    Result<ContourMesh> mesh = contour_levels(world, c.levels, config, ctx, stats);
+    if (!mesh.ok()) return mesh;
+    // The self-intersection search is skipped: only the topology is asked.
+    const MeshQuality q = mesh_quality(mesh.value(), {.known_self_intersecting_pairs = 0});
+    if (q.nonmanifold_edges == 0 && q.nonmanifold_vertices == 0) {
+      c.used = true;
+      return mesh;
+    }
+    c.fell_back = true;
+  }
+  return contour_world(world, config, ctx, stats);
 }
 
 }  // namespace ldc

@@ -9,9 +9,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "contour/contour.h"
+#include "csg/csg.h"
 #include "ldc/build.h"
 #include "test_util.h"
 
@@ -36,6 +38,16 @@ World build(const TriangleMesh& mesh) {
   g.chunk_size = 32;
   return build_from_mesh(mesh, g).value();
 }
+
+// A slab whose top is material 1 for x > 0.5 m and 0 elsewhere.
+class TwoMaterialSlab final : public ImplicitSolid {
+ public:
+  double value(const glm::dvec3& p) const override {
+    return std::max({0.05 - p.x, p.x - 0.9, 0.05 - p.y, p.y - 0.9, 0.05 - p.z, p.z - 0.3});
+  }
+  uint16_t material(const glm::dvec3& p) const override { return p.x > 0.5 ? 1 : 0; }
+  WorldBox bounds() const override { return {{0.05, 0.05, 0.05}, {0.9, 0.9, 0.3}}; }
+};
 
 // The mean distance from a mesh's vertices to the cube's surface (cube
 // turned as turned_cube; in its own frame the distance to a box).
@@ -118,22 +130,63 @@ TEST(SurfaceLevels, TheSameLevelsForAnyThreadCount) {
   EXPECT_TRUE(q.closed()) << quality_failures(q);
 }
 
-// A slab whose top is material 1 for x > 0.5 m and 0 elsewhere.
-class TwoMaterialSlab final : public ImplicitSolid {
- public:
-  double value(const glm::dvec3& p) const override {
-    return std::max({0.05 - p.x, p.x - 0.9, 0.05 - p.y, p.y - 0.9, 0.05 - p.z, p.z - 0.3});
-  }
-  uint16_t material(const glm::dvec3& p) const override { return p.x > 0.5 ? 1 : 0; }
-  WorldBox bounds() const override { return {{0.05, 0.05, 0.05}, {0.9, 0.9, 0.3}}; }
-};
-
 // contour_levels leaves material borders unrelaxed, so callers need to know.
 TEST(SurfaceLevels, SaysWhenTheSurfaceHoldsSeveralMaterials) {
   GridConfig g = test::lattice_at_origin(kH);
   g.chunk_size = 32;
   EXPECT_TRUE(surface_levels(build_from_implicit(TwoMaterialSlab(), g).value()).value().several_materials);
   EXPECT_FALSE(surface_levels(build(turned_cube(glm::dvec3(0.5), 0.7))).value().several_materials);
+}
+
+// What the tools run before simplifying: levels where they pay off, and
+// always a mesh with no non-manifold edge or vertex.
+TEST(SurfaceLevels, ContourAtSurfaceLevelsUsesThemWhereTheyPayOff) {
+  ContourConfig raw;
+  raw.untangle = false;
+  SurfaceLevelChoice cube;
+  const World turned = build(turned_cube(glm::dvec3(0.5), 0.7));
+  const ContourMesh m = contour_at_surface_levels(turned, 0.02, raw, nullptr, nullptr, &cube).value();
+  EXPECT_TRUE(cube.used);
+  EXPECT_FALSE(cube.fell_back);
+  EXPECT_EQ(m.triangle_count(), contour_levels(turned, cube.levels, raw).value().triangle_count());
+  SurfaceLevelChoice sphere;
+  const World round = build(test::sphere_mesh(glm::dvec3(0.3), 20 * kH, 5));
+  const ContourMesh s = contour_at_surface_levels(round, 0.02, raw, nullptr, nullptr, &sphere).value();
+  EXPECT_FALSE(sphere.used);
+  EXPECT_EQ(s.triangle_count(), contour_world(round, raw).value().triangle_count());
+  // Two materials: kept on one level while borders are to be relaxed, not when relaxation is off.
+  GridConfig g = test::lattice_at_origin(kH);
+  g.chunk_size = 32;
+  const World slab = build_from_implicit(TwoMaterialSlab(), g).value();
+  SurfaceLevelChoice relaxed, plain;
+  ASSERT_TRUE(contour_at_surface_levels(slab, 0.02, raw, nullptr, nullptr, &relaxed).ok());
+  EXPECT_FALSE(relaxed.used);
+  ContourConfig no_relax = raw;
+  no_relax.relax_iterations = 0;
+  ASSERT_TRUE(contour_at_surface_levels(slab, 0.02, no_relax, nullptr, nullptr, &plain).ok());
+  EXPECT_TRUE(plain.used);
+}
+
+// Two turned boxes (tests/data/turned_box_*.obj) whose union contour_levels
+// meshed with a non-manifold seam between levels: the result is manifold
+// whichever way it was made.
+TEST(SurfaceLevels, ContourAtSurfaceLevelsNeverReturnsANonManifoldMesh) {
+  const World w = build_from_mesh(test::load_test_mesh("turned_box_a.obj"), {.cells = 256}).value();
+  const World both = mesh_boolean(test::load_test_mesh("turned_box_a.obj"), test::load_test_mesh("turned_box_b.obj"),
+                                  BooleanOp::kUnion, {.cells = 256})
+                         .value();
+  ContourConfig raw;
+  raw.untangle = false;
+  for (const World* world : {&w, &both}) {
+    SurfaceLevelChoice choice;
+    const ContourMesh m = contour_at_surface_levels(*world, 0.02, raw, nullptr, nullptr, &choice).value();
+    const MeshQuality q = mesh_quality(m);
+    EXPECT_EQ(q.nonmanifold_edges, 0u);
+    EXPECT_EQ(q.nonmanifold_vertices, 0u);
+    EXPECT_TRUE(q.watertight());
+    EXPECT_TRUE(choice.used || choice.fell_back || !surface_levels_pay_off(choice.levels));
+    std::printf("used %d, fell back %d\n", int(choice.used), int(choice.fell_back));
+  }
 }
 
 TEST(SurfaceLevels, ChunksWithoutSurfaceTakeTheTopLevel) {

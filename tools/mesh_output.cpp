@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <cstdio>
-#include <optional>
 
 #include "ldc/lod.h"
 #include "meshio/meshio.h"
@@ -11,8 +10,26 @@
 namespace ldc::tool {
 namespace {
 
-Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, const std::optional<ChunkLevels>& levels,
-                               Context* ctx, ContourStats* stats) {
+// Adaptive output meshes at the levels the surface allows (surface_levels
+// at a tenth of the bound) where that pays off.
+bool wants_surface_levels(const MeshOutputArgs& a) {
+  return a.surface_levels && a.max_error_cells > 0.0 && a.method != "mc" && !a.level_of_chunk;
+}
+
+// report["surface_levels"]: the chunks per level and what was done with them.
+nlohmann::json surface_levels_json(const World& w, const SurfaceLevelChoice& c, double tolerance, bool relaxes) {
+  nlohmann::json chunks = nlohmann::json::array();
+  for (int k = 0; k <= max_lod_level(w.chunk_size()); ++k) chunks.push_back(c.levels.surface_chunks(k));
+  return {{"tolerance_cells", tolerance},
+          {"chunks_by_level", chunks},
+          {"several_materials", c.levels.several_materials},
+          {"borders_relaxed", relaxes},
+          {"fell_back", c.fell_back},
+          {"used", c.used}};
+}
+
+Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats* stats,
+                               nlohmann::json& report) {
   if (a.method == "mc" && a.level_of_chunk) {
     return Status(ErrorCode::kInvalidArgument, "--method mc has no levels of detail: leave out --lod-bands");
   }
@@ -29,32 +46,15 @@ Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, const st
   // the contouring time.
   c.untangle = false;
   if (a.level_of_chunk) return contour_levels(w, a.level_of_chunk, c, ctx, stats);
-  if (levels) return contour_levels(w, *levels, c, ctx, stats);
-  return contour_world(w, c, ctx, stats);
-}
-
-// Adaptive output: the chunks' levels by surface_levels, at a tenth of the
-// bound, kept when the cost model says they pay off (report["surface_levels"]).
-Result<std::optional<ChunkLevels>> choose_levels(const World& w, const MeshOutputArgs& a, Context* ctx,
-                                                 nlohmann::json& report) {
-  if (!a.surface_levels || a.max_error_cells <= 0.0 || a.method == "mc" || a.level_of_chunk) return std::optional<ChunkLevels>();
-  ScopedTimer t(nullptr, "");
-  const SurfaceLevelOptions options{.tolerance = a.max_error_cells / 10.0};
-  Result<ChunkLevels> levels = surface_levels(w, options, ctx);
-  if (!levels.ok()) return levels.status();
-  // contour_levels leaves material borders unrelaxed: keep one level where relaxing was asked for.
-  const bool relaxes = levels.value().several_materials && a.config.relax_iterations > 0;
-  const bool used = !relaxes && surface_levels_pay_off(levels.value());
-  nlohmann::json chunks = nlohmann::json::array();
-  for (int k = 0; k <= max_lod_level(w.chunk_size()); ++k) chunks.push_back(levels.value().surface_chunks(k));
-  report["surface_levels"] = {{"tolerance_cells", options.tolerance},
-                               {"chunks_by_level", chunks},
-                               {"several_materials", levels.value().several_materials},
-                               {"borders_relaxed", relaxes},
-                               {"used", used}};
-  report["seconds"]["surface_levels"] = t.seconds();
-  if (!used) return std::optional<ChunkLevels>();
-  return std::optional<ChunkLevels>(std::move(levels.value()));
+  if (!wants_surface_levels(a)) return contour_world(w, c, ctx, stats);
+  const double tolerance = a.max_error_cells / 10.0;
+  SurfaceLevelChoice choice;
+  Result<ContourMesh> mesh = contour_at_surface_levels(w, tolerance, c, ctx, stats, &choice);
+  if (!mesh.ok()) return mesh;
+  const bool relaxes = choice.levels.several_materials && c.relax_iterations > 0;
+  report["surface_levels"] = surface_levels_json(w, choice, tolerance, relaxes);
+  report["seconds"]["surface_levels"] = choice.levels_seconds;
+  return mesh;
 }
 
 ExportOptions export_options(const World& w) {
@@ -159,11 +159,9 @@ Status simplify_and_untangle_output(const World& w, const MeshOutputArgs& a, Con
 // contouring with untangling on), timing each step.
 Result<ContourMesh> mesh_world(const World& w, const MeshOutputArgs& a, Context* ctx, ContourStats& stats,
                                nlohmann::json& report) {
-  Result<std::optional<ChunkLevels>> levels = choose_levels(w, a, ctx, report);
-  if (!levels.ok()) return levels.status();
   ScopedTimer t(nullptr, "");
-  Result<ContourMesh> mesh = run_method(w, a, levels.value(), ctx, &stats);
-  report["seconds"]["contour"] = t.seconds();
+  Result<ContourMesh> mesh = run_method(w, a, ctx, &stats, report);
+  report["seconds"]["contour"] = t.seconds() - report["seconds"].value("surface_levels", 0.0);  // reported on its own
   if (!mesh.ok()) return mesh;
   const bool untangle = a.method != "mc" && a.config.untangle;
   if (a.max_error_cells > 0.0 && untangle) {
@@ -198,9 +196,10 @@ void print_report(const nlohmann::json& j) {
     const auto& l = j["surface_levels"];
     std::string counts;
     for (const auto& n : l["chunks_by_level"]) counts += (counts.empty() ? "" : " / ") + std::to_string(n.get<size_t>());
-    const char* why = l["used"].get<bool>()                ? "meshed at these levels"
-                      : l["borders_relaxed"].get<bool>()   ? "one level: material borders are relaxed there"
-                                                           : "one level: the levels would not pay off";
+    const char* why = l["used"].get<bool>()              ? "meshed at these levels"
+                      : l["fell_back"].get<bool>()       ? "one level: a seam between levels came out non-manifold"
+                      : l["borders_relaxed"].get<bool>() ? "one level: material borders are relaxed there"
+                                                         : "one level: the levels would not pay off";
     std::printf("  surface levels: chunks with surface at level 0 / 1 / ...: %s (%s)\n", counts.c_str(), why);
   }
   if (j.contains("untangle") && j["untangle"]["pairs_before"].get<size_t>() > 0) {
