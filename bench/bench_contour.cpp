@@ -64,7 +64,7 @@ ldc::TriangleMesh ldc_remesh(const ldc::TriangleMesh& in, double h, ldc::Contour
   if (mc) return ldc::to_triangle_mesh(ldc::marching_cubes(w).value());
   config.untangle = false;
   ldc::ContourMesh m = max_error_cells > 0.0
-                           ? ldc::contour_at_surface_levels(w, max_error_cells / 10.0, config).value()
+                           ? ldc::contour_at_surface_levels(w, ldc::surface_level_tolerance(max_error_cells), config).value()
                            : ldc::contour_world(w, config).value();
   if (max_error_cells > 0.0) {
     ldc::SimplifyStats s =

@@ -369,11 +369,16 @@ bool surface_levels_pay_off(const ChunkLevels& levels);
 // check catches it and one level is meshed instead.) `config` as for
 // either (untangle as given). Errors: those of the three calls.
 struct SurfaceLevelChoice {
-  ChunkLevels levels;       // as surface_levels chose them
-  bool used = false;        // the mesh is contour_levels's at `levels`
-  bool fell_back = false;   // contour_levels's mesh was non-manifold: contour_world's instead
+  ChunkLevels levels;            // as surface_levels chose them
+  bool used = false;             // the mesh is contour_levels's at `levels`
+  bool borders_relaxed = false;  // one level because several materials' borders are to be relaxed
+  bool fell_back = false;        // contour_levels's mesh was non-manifold: contour_world's instead
   double levels_seconds = 0.0;  // surface_levels's time
 };
+// The tolerance the tools give contour_at_surface_levels for an adaptive
+// bound (both in cells of h): a tenth of it, so that coarse levels add
+// little to the simplifier's error.
+inline double surface_level_tolerance(double max_error_cells) { return max_error_cells / 10.0; }
 Result<ContourMesh> contour_at_surface_levels(const World& world, double tolerance, const ContourConfig& config = {},
                                               Context* ctx = nullptr, ContourStats* stats = nullptr,
                                               SurfaceLevelChoice* choice = nullptr);

@@ -1078,9 +1078,7 @@ std::vector<glm::ivec3> LevelChunkedMesh::near_changes(const World& world, std::
   });
   const glm::ivec3 lo = box_.origin - 1, hi = box_.origin + box_.dims;
   std::vector<glm::ivec3> out = chunks_a_change_reaches(changed);
-  std::erase_if(out, [&](const glm::ivec3& n) {
-    return !glm::all(glm::greaterThanEqual(n, lo)) || !glm::all(glm::lessThan(n, hi));
-  });
+  std::erase_if(out, [&](const glm::ivec3& n) { return !detail::in_box(n, lo, hi); });
   return out;
 }
 

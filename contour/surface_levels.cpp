@@ -39,36 +39,32 @@ struct ChunkReader {
   Region fine, coarse;
 };
 
-// The smallest distance (cells) from p to the Hermite plane of a crossing
-// of `material` on a sign-changing level-k edge of coarse cell `cell`
-// (coarse lattice coordinates); infinity when it has none.
-double distance_to_cell_planes(const Region& coarse, const glm::ivec3& cell, int s, const glm::dvec3& p,
-                               uint16_t material) {
-  double best = INFINITY;
+// How coarse cell `cell` (coarse lattice coordinates) explains point p: the
+// smallest distance (cells) from p to the Hermite plane of a crossing of
+// `material` on one of its sign-changing level-k edges (infinity when none),
+// and whether it has any crossing at all.
+struct CellFit {
+  bool any_crossing = false;
+  double distance = INFINITY;
+};
+CellFit fit_to_cell(const Region& coarse, const glm::ivec3& cell, int s, const glm::dvec3& p, uint16_t material) {
+  CellFit fit;
   for (int axis = 0; axis < 3; ++axis) {
     const EdgeCrossing* edges[4];
     coarse.cell_edges(axis, cell, edges);
     for (int j = 0; j < 4; ++j) {
       const EdgeCrossing* q = edges[j];
-      if (!q || q->material != material) continue;
+      if (!q) continue;
+      fit.any_crossing = true;
+      if (q->material != material) continue;
       glm::dvec3 at(cell);
       at[axis_u(axis)] += j & 1;
       at[axis_v(axis)] += j >> 1;
       at[axis] += q->t;
-      best = std::min(best, std::abs(glm::dot(glm::dvec3(q->normal), p - double(s) * at)));
+      fit.distance = std::min(fit.distance, std::abs(glm::dot(glm::dvec3(q->normal), p - double(s) * at)));
     }
   }
-  return best;
-}
-
-bool has_crossing(const Region& coarse, const glm::ivec3& cell) {
-  for (int axis = 0; axis < 3; ++axis) {
-    const EdgeCrossing* edges[4];
-    coarse.cell_edges(axis, cell, edges);
-    for (const EdgeCrossing* e : edges)
-      if (e) return true;
-  }
-  return false;
+  return fit;
 }
 
 // Whether a coarse cell with no sign-changing edge holds only level-0 nodes
@@ -107,8 +103,8 @@ bool level_keeps_surface(const World& world, const glm::ivec3& chunk, int k, dou
     p[e.axis] += c->t;
     // floor(p / s): the node's own coarse cell (t < 1 keeps p below the next coarse node).
     const glm::ivec3 cell = glm::clamp(e.node >> k, coarse_lo, last_cell);
-    if (has_crossing(r.coarse, cell)) {
-      if (distance_to_cell_planes(r.coarse, cell, s, p, c->material) > tolerance) return false;
+    if (const CellFit own = fit_to_cell(r.coarse, cell, s, p, c->material); own.any_crossing) {
+      if (own.distance > tolerance) return false;
       continue;
     }
     if (!no_enclosed_part(r.fine, r.coarse, cell, s)) return false;
@@ -117,8 +113,8 @@ bool level_keeps_surface(const World& world, const glm::ivec3& chunk, int k, dou
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const glm::ivec3 other = cell + glm::ivec3(dx, dy, dz);
-          if (glm::any(glm::lessThan(other, coarse_lo)) || glm::any(glm::greaterThan(other, last_cell))) continue;
-          best = std::min(best, distance_to_cell_planes(r.coarse, other, s, p, c->material));
+          if (!detail::in_box(other, coarse_lo, last_cell + 1)) continue;
+          best = std::min(best, fit_to_cell(r.coarse, other, s, p, c->material).distance);
         }
     if (best > tolerance) return false;
   }
@@ -211,8 +207,8 @@ Result<ContourMesh> contour_at_surface_levels(const World& world, double toleran
   if (!levels.ok()) return levels.status();
   c.levels = std::move(levels.value());
   c.levels_seconds = timer.seconds();
-  const bool relaxes = c.levels.several_materials && config.relax_iterations > 0;
-  if (!relaxes && surface_levels_pay_off(c.levels)) {
+  c.borders_relaxed = c.levels.several_materials && config.relax_iterations > 0;
+  if (!c.borders_relaxed && surface_levels_pay_off(c.levels)) {
     Result<ContourMesh> mesh = contour_levels(world, c.levels, config, ctx, stats);
     if (!mesh.ok()) return mesh;
     // The self-intersection search is skipped: only the topology is asked.

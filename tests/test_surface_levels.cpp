@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 
 #include "contour/contour.h"
@@ -161,10 +160,12 @@ TEST(SurfaceLevels, ContourAtSurfaceLevelsUsesThemWhereTheyPayOff) {
   SurfaceLevelChoice relaxed, plain;
   ASSERT_TRUE(contour_at_surface_levels(slab, 0.02, raw, nullptr, nullptr, &relaxed).ok());
   EXPECT_FALSE(relaxed.used);
+  EXPECT_TRUE(relaxed.borders_relaxed);
   ContourConfig no_relax = raw;
   no_relax.relax_iterations = 0;
   ASSERT_TRUE(contour_at_surface_levels(slab, 0.02, no_relax, nullptr, nullptr, &plain).ok());
   EXPECT_TRUE(plain.used);
+  EXPECT_FALSE(plain.borders_relaxed);
 }
 
 // Two turned boxes (tests/data/turned_box_*.obj) whose union contour_levels
@@ -185,7 +186,6 @@ TEST(SurfaceLevels, ContourAtSurfaceLevelsNeverReturnsANonManifoldMesh) {
     EXPECT_EQ(q.nonmanifold_vertices, 0u);
     EXPECT_TRUE(q.watertight());
     EXPECT_TRUE(choice.used || choice.fell_back || !surface_levels_pay_off(choice.levels));
-    std::printf("used %d, fell back %d\n", int(choice.used), int(choice.fell_back));
   }
 }
 

@@ -17,13 +17,13 @@ bool wants_surface_levels(const MeshOutputArgs& a) {
 }
 
 // report["surface_levels"]: the chunks per level and what was done with them.
-nlohmann::json surface_levels_json(const World& w, const SurfaceLevelChoice& c, double tolerance, bool relaxes) {
+nlohmann::json surface_levels_json(const World& w, const SurfaceLevelChoice& c, double tolerance) {
   nlohmann::json chunks = nlohmann::json::array();
   for (int k = 0; k <= max_lod_level(w.chunk_size()); ++k) chunks.push_back(c.levels.surface_chunks(k));
   return {{"tolerance_cells", tolerance},
           {"chunks_by_level", chunks},
           {"several_materials", c.levels.several_materials},
-          {"borders_relaxed", relaxes},
+          {"borders_relaxed", c.borders_relaxed},
           {"fell_back", c.fell_back},
           {"used", c.used}};
 }
@@ -47,12 +47,11 @@ Result<ContourMesh> run_method(const World& w, const MeshOutputArgs& a, Context*
   c.untangle = false;
   if (a.level_of_chunk) return contour_levels(w, a.level_of_chunk, c, ctx, stats);
   if (!wants_surface_levels(a)) return contour_world(w, c, ctx, stats);
-  const double tolerance = a.max_error_cells / 10.0;
+  const double tolerance = surface_level_tolerance(a.max_error_cells);
   SurfaceLevelChoice choice;
   Result<ContourMesh> mesh = contour_at_surface_levels(w, tolerance, c, ctx, stats, &choice);
   if (!mesh.ok()) return mesh;
-  const bool relaxes = choice.levels.several_materials && c.relax_iterations > 0;
-  report["surface_levels"] = surface_levels_json(w, choice, tolerance, relaxes);
+  report["surface_levels"] = surface_levels_json(w, choice, tolerance);
   report["seconds"]["surface_levels"] = choice.levels_seconds;
   return mesh;
 }

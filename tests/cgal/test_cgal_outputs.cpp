@@ -26,7 +26,7 @@ constexpr double kToolMaxErrorCells = 0.2;  // ldc remesh / boolean --max-error 
 // allows, contour_at_surface_levels) and checks the result with CGAL.
 void expect_valid_output(const World& w, double max_error_cells, const std::string& name) {
   ContourMesh m = max_error_cells > 0.0
-                      ? contour_at_surface_levels(w, max_error_cells / 10.0, {.untangle = false}).value()
+                      ? contour_at_surface_levels(w, surface_level_tolerance(max_error_cells), {.untangle = false}).value()
                       : contour_world(w, {.untangle = false}).value();
   const size_t uniform = m.triangle_count();
   if (max_error_cells > 0.0) {
