@@ -15,7 +15,9 @@ Usage: python3 bench/validity_sweep.py KIND [--seed S] [--runs N] [--ldc PATH] [
 
 Each output goes to cgal_check_mesh (tests/cgal/cgal_check_mesh.cpp: CGAL's is_valid_polygon_mesh,
 is_closed, does_self_intersect); an empty result (disjoint shapes intersected) counts as valid.
-Prints each invalid case (its inputs are kept in the work folder) and "invalid: n of N" last.
+Prints each invalid case (its inputs are kept in the work folder), each case whose level mesh fell back
+to one level (ldc --json's surface_levels.fell_back: contour_levels left it non-manifold), and
+"invalid: n of N" last.
 Needs python3 (standard library only) and a build with CGAL (build/tests/cgal_check_mesh).
 Bench only: not run by the tests or CI. Used for issue 19 (docs/contour.md).
 """
@@ -89,9 +91,23 @@ class Sweep:
     def __init__(self, args):
         self.ldc, self.check, self.work = args.ldc, args.check, args.work
         self.invalid = 0
+        self.fell_back = 0
 
     def run(self, cmd):
         return subprocess.run(cmd, capture_output=True, text=True)
+
+    def run_ldc(self, cmd, case):
+        """Runs an ldc command with --json; counts (and prints) a level mesh that fell back to one level."""
+        r = self.run(cmd + ["--json"])
+        if r.returncode == 0:
+            try:
+                levels = json.loads(r.stdout).get("surface_levels", {})
+            except ValueError:
+                levels = {}
+            if levels.get("fell_back"):
+                self.fell_back += 1
+                print("FELL-BACK", " ".join(str(x) for x in case), flush=True)
+        return r
 
     def judge(self, case, out, keep=()):
         c = self.run([self.check, out])
@@ -119,7 +135,7 @@ class Sweep:
         out = os.path.join(self.work, "out.obj")
         cmd = [self.ldc, "--threads", "2", "-q", "boolean", a, b, "--op", op, "--cells", str(cells), "--scale-b",
                repr(scale), "--translate-b", ",".join(repr(x) for x in t), "-o", out] + extra
-        r = self.run(cmd)
+        r = self.run_ldc(cmd, (i, " ".join(cmd[4:])))
         if r.returncode != 0:
             print("LDC-ERROR", i, " ".join(cmd[4:]), r.stderr.strip()[-200:], flush=True)
             return
@@ -148,8 +164,8 @@ class Sweep:
         cells = rng.choice([32, 50, 64, 128, 256])
         extra = rng.choice([[], [], ["--max-error", "0"], ["--chunk", "16"]])
         out = os.path.join(self.work, "out.obj")
-        r = self.run([self.ldc, "--threads", "2", "-q", "boolean", fa, fb, "--op", op, "--cells", str(cells),
-                      "-o", out] + extra)
+        r = self.run_ldc([self.ldc, "--threads", "2", "-q", "boolean", fa, fb, "--op", op, "--cells", str(cells),
+                          "-o", out] + extra, (i, placement, op, cells))
         if r.returncode != 0:
             print("LDC-ERROR", i, placement, op, cells, extra, r.stderr.strip()[-200:], flush=True)
             return
@@ -161,7 +177,8 @@ class Sweep:
         extra = rng.choice([[], [], ["--max-error", "0"], ["--max-error", "0.05"], ["--max-error", "1"],
                             ["--target-triangles", "2000"], ["--chunk", "16"]])
         out = os.path.join(self.work, "out.obj")
-        r = self.run([self.ldc, "--threads", "2", "-q", "remesh", a, "--cells", str(cells), "-o", out] + extra)
+        r = self.run_ldc([self.ldc, "--threads", "2", "-q", "remesh", a, "--cells", str(cells), "-o", out] + extra,
+                         (i, "remesh", a, cells))
         if r.returncode != 0:
             print("LDC-ERROR", i, a, cells, extra, r.stderr.strip()[-200:], flush=True)
             return
@@ -236,6 +253,7 @@ def main():
         else:
             sweep.edit(i, rng, world)
     print("work folder:", args.work)
+    print("fell back to one level (a level mesh came out non-manifold): %d of %d" % (sweep.fell_back, args.runs))
     print("invalid: %d of %d" % (sweep.invalid, args.runs))
 
 

@@ -276,11 +276,6 @@ class ChunkedMesh {
 // read from `world` in place. Cost: about that of meshing each chunk at its
 // level (a chunk beside a finer one costs more).
 //
-// Known bug: on sharp CSG solids a seam between levels has come out
-// non-manifold (one edge, two vertices; tests/data/turned_box_*.obj at 256
-// cells with surface_levels's levels): contour_at_surface_levels checks for
-// it; other callers may check with mesh_quality.
-//
 // Differences from contour_world (and contour_chunk_levels from contour_chunk): no relaxation of material borders (vertices
 // stay at their Hermite placement) and no local untangling round; with
 // config.untangle (the default), untangle_mesh runs on the whole result
@@ -364,9 +359,8 @@ bool surface_levels_pay_off(const ChunkLevels& levels);
 // surface_levels_pay_off says so, the surface holds one material or
 // config.relax_iterations is 0 (contour_levels does not relax material
 // borders), and its mesh has no non-manifold edge or vertex; otherwise
-// contour_world. (contour_levels has left a seam between levels
-// non-manifold on sharp CSG solids, tests/data/turned_box_*.obj: the
-// check catches it and one level is meshed instead.) `config` as for
+// contour_world. (The check is a guard: it caught a seam contour_levels
+// left non-manifold on sharp CSG solids, since mended.) `config` as for
 // either (untangle as given). Errors: those of the three calls.
 struct SurfaceLevelChoice {
   ChunkLevels levels;            // as surface_levels chose them

@@ -451,6 +451,7 @@ struct LevelVertex {
   uint16_t material = 0;
   glm::ivec3 cell_lo{0};
   uint8_t sheet = 0;
+  uint8_t level = 0;  // the cell is 2^level lattice cells wide
   Qef qef;            // level-0 units, about cell_lo
 };
 
@@ -629,6 +630,7 @@ class ChunkMesher {
     v.normal = planes.mean_normal();
     v.material = planes.majority_material();
     v.cell_lo = cell.lo;
+    v.level = uint8_t(cell.level);
     v.sheet = uint8_t(sheet);
     v.qef = Qef::of(planes);
     return v;
@@ -670,9 +672,20 @@ struct PolygonVertex {
   const LevelVertex* v;
 };
 
-// Triangles of a quad: the diagonal whose midpoint fits the Hermite planes
-// of its two end cells best (ties: the shorter), as the uniform mesher does.
-bool split_along_02(const PolygonVertex p[4]) {
+// Triangles of a quad around an edge 2^edge_level long: the diagonal whose
+// midpoint fits the Hermite planes of its two end cells best (ties: the
+// shorter), as the uniform mesher does, except across two cells both wider
+// than the edge. Those meet along a line cut into several edges (a coarse
+// line beside a finer chunk), and the quads of the next edges on it have
+// the same two cells as opposite corners: where two such edges cross, one
+// diagonal in both would give an edge of four triangles (found on two
+// turned boxes' union, a sheet of the third cell looping over those two
+// edges alone). The other diagonal holds a cell as wide as the edge (the
+// finest chunk around the line has one there), so it lies in this quad only.
+bool split_along_02(const PolygonVertex p[4], int edge_level) {
+  auto wider = [&](int i) { return p[i].v->level > edge_level; };
+  if (wider(0) && wider(2)) return false;
+  if (wider(1) && wider(3)) return true;
   const glm::dvec3 m02 = 0.5 * (p[0].v->x + p[2].v->x), m13 = 0.5 * (p[1].v->x + p[3].v->x);
   auto err = [&](int i, const glm::dvec3& m) { return p[i].v->qef.error(m - glm::dvec3(p[i].v->cell_lo)); };
   const glm::dvec3 corners[4] = {p[0].v->x, p[1].v->x, p[2].v->x, p[3].v->x};
@@ -698,7 +711,7 @@ bool emit_polygon(const OwnedEdge& e, Lookup&& lookup, std::vector<glm::uvec3>& 
   if (n == 3) {
     tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
     mats.push_back(e.material);
-  } else if (split_along_02(ring)) {
+  } else if (split_along_02(ring, e.level)) {
     tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
     tris.emplace_back(ring[0].index, ring[2].index, ring[3].index);
     mats.insert(mats.end(), 2, e.material);

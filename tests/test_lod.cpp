@@ -279,6 +279,25 @@ TEST(LodLevels, ScatteredLevelsMeshClosedAcrossEverySeam) {
   }
 }
 
+// Two turned boxes' union (sharp CSG) at the levels surface_levels gives: a
+// coarse line beside a finer chunk is cut into two crossing edges whose quads
+// have the same two diagonal cells as opposite corners. Both quads were split
+// along that diagonal, an edge of four triangles; now the mesh is a closed
+// 2-manifold without untangling.
+TEST(LodLevels, CoarseCellsMeetingAlongACutLineKeepAManifoldSeam) {
+  const World w = mesh_boolean(test::load_test_mesh("turned_box_a.obj"), test::load_test_mesh("turned_box_b.obj"),
+                               BooleanOp::kUnion, {.cells = 200})
+                      .value();
+  const ChunkLevels levels = surface_levels(w, {.tolerance = 0.02}).value();
+  ASSERT_GT(levels.surface_chunks(0), 0u);  // a seam between levels exists
+  ASSERT_GT(levels.surface_chunks(2), 0u);
+  const ContourMesh raw = contour_levels(w, levels, levels_test::plain_config()).value();
+  const MeshQuality q = mesh_quality(raw, {.known_self_intersecting_pairs = 0});
+  EXPECT_EQ(q.nonmanifold_edges, 0u);
+  EXPECT_EQ(q.nonmanifold_vertices, 0u);
+  EXPECT_TRUE(q.watertight()) << quality_failures(q);
+}
+
 // A ring of levels by distance from a point, as a camera would choose them,
 // on a landscape with caves and overhangs: closed, and between level 2's and
 // level 0's triangle counts.
