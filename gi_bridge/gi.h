@@ -67,6 +67,13 @@
 // (GiLayout::face_src), so a cone entering a wall, which samples both
 // voxels, sees the wall's full radiance.
 // Emission (MaterialTable) is written into D directly.
+// Sealed air: the sky counts only from air a flood from the cascades' box
+// faces reaches (through voxels under half solid), and air it does not
+// reach forms pockets; a pocket holding no point light and no glowing face
+// is black: its faces store no light and a query whose apex sees only its
+// air gets none (walls thinner than a coarse voxel would otherwise let the
+// outside's light in). load() numbers the pockets; set_lights() re-marks
+// them when a light enters or leaves one.
 //
 // Outputs: radiance() reads back the per-face light cascades; irradiance()
 // answers batches of points with normals by 16 cones from each point.

@@ -92,6 +92,11 @@ class CpuGi final : public GiEngineBase {
     return upload_lights(layout);
   }
 
+  Status upload_vmap(const GiLayout& layout) override {
+    b_.vmap = layout.vmap;
+    return {};
+  }
+
   Status upload_lights(const GiLayout& layout) override {
     params_ = layout.params;
     b_.plight = layout.light_volume;

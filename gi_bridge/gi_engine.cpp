@@ -354,20 +354,165 @@ void restrict_to_finer(const Cascades& cascades, int l, const std::vector<uint8_
       }
 }
 
-// Writes the flags into vmap's bit 30 (-2 for a voxel with no surface).
-void mark_sky_open(const Cascades& cascades, GiLayout& out) {
+// Sets or clears flag bits (kVoxelAir, ...) of one vmap entry: bits 28 ..
+// 30 of a surface voxel's index, -1 - flags for a voxel with no surface
+// (the shaders' vmap_flags).
+void set_voxel_flag(int32_t& v, int32_t flag, bool on) {
+  int32_t flags = v < 0 ? -1 - v : (v >> 28) & 7;
+  flags = on ? (flags | flag) : (flags & ~flag);
+  v = v < 0 ? -1 - flags : (v & 0x0FFFFFFF) | (flags << 28);
+}
+bool voxel_flag(int32_t v, int32_t flag) { return ((v < 0 ? -1 - v : (v >> 28) & 7) & flag) != 0; }
+
+// Writes the flags into vmap (kVoxelOpen; kVoxelAir where less than half
+// solid) and returns them, per level.
+std::vector<std::vector<uint8_t>> mark_sky_open(const Cascades& cascades, GiLayout& out) {
   std::vector<std::vector<uint8_t>> flags(size_t(out.k));
   for (int l = out.k - 1; l >= 0; --l)
     flags[size_t(l)] = flood_level(cascades, l, l + 1 < out.k ? &flags[size_t(l) + 1] : nullptr, out);
   for (int l = 0; l + 1 < out.k; ++l) restrict_to_finer(cascades, l, flags[size_t(l)], flags[size_t(l) + 1], out.n);
   for (int l = 0; l < out.k; ++l) {
     const size_t first = out.voxel(l, glm::ivec3(0));
+    const VoxelBox box = cascades.level_box(l);
     for (size_t i = 0; i < flags[size_t(l)].size(); ++i) {
-      if (!flags[size_t(l)][i]) continue;
       int32_t& v = out.vmap[first + i];
-      v = v < 0 ? -2 : (v | 0x40000000);
+      if (flags[size_t(l)][i]) set_voxel_flag(v, kVoxelOpen, true);
+      const glm::ivec3 c(int(i % size_t(out.n)), int(i / size_t(out.n) % size_t(out.n)),
+                         int(i / (size_t(out.n) * size_t(out.n))));
+      if (cascades.occupancy(l, box.lo + c) < 0.5f) set_voxel_flag(v, kVoxelAir, true);
     }
   }
+  return flags;
+}
+
+bool in_level(int n, const glm::ivec3& c) {
+  return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n)));
+}
+
+// Sealed air (issue 25): the voxels the sky flood did not reach, less than
+// half solid, in 6-connected pockets numbered across all levels
+// (GiLayout::pocket), and which pockets an emissive face looks into
+// (pocket_glows). Light cannot get into a pocket through its walls; with
+// no light source inside, everything in it is black (see mark_dark).
+void label_pockets(const Cascades& cascades, const std::vector<std::vector<uint8_t>>& open, GiLayout& out) {
+  const int n = out.n;
+  out.pocket.assign(out.voxels(), -1);
+  int32_t pockets = 0;
+  std::vector<glm::ivec3> stack;
+  for (int l = 0; l < out.k; ++l) {
+    const VoxelBox box = cascades.level_box(l);
+    const size_t first = out.voxel(l, glm::ivec3(0));
+    auto sealed_air = [&](const glm::ivec3& c) {
+      const size_t i = level_local_index(n, c);
+      return !open[size_t(l)][i] && out.pocket[first + i] < 0 && cascades.occupancy(l, box.lo + c) < 0.5f;
+    };
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          if (!sealed_air({x, y, z})) continue;
+          const int32_t id = pockets++;
+          out.pocket[first + level_local_index(n, {x, y, z})] = id;
+          stack.assign(1, glm::ivec3(x, y, z));
+          while (!stack.empty()) {
+            const glm::ivec3 c = stack.back();
+            stack.pop_back();
+            for (int f = 0; f < kFaces; ++f) {
+              glm::ivec3 nb = c;
+              nb[face_axis(f)] += face_positive(f) ? 1 : -1;
+              if (!in_level(n, nb) || !sealed_air(nb)) continue;
+              out.pocket[first + level_local_index(n, nb)] = id;
+              stack.push_back(nb);
+            }
+          }
+        }
+  }
+  out.pocket_glows.assign(size_t(pockets), 0);
+  for (size_t s = 0; s < out.surfaces(); ++s) {
+    const int l = out.surf_pos[s].w;
+    if (!s_is_updated(out, l, int32_t(s))) continue;
+    for (int f = 0; f < kFaces; ++f) {
+      const glm::vec4 emission = out.attr[(s * 6 + size_t(f)) * 3 + 2];
+      if (out.attr[(s * 6 + size_t(f)) * 3].w <= 0.0f || glm::max(emission.x, glm::max(emission.y, emission.z)) <= 0.0f)
+        continue;
+      const glm::ivec3 c(out.surf_pos[s]);
+      for (int g = -1; g < kFaces; ++g) {  // the voxel and its six neighbours
+        glm::ivec3 nb = c;
+        if (g >= 0) nb[face_axis(g)] += face_positive(g) ? 1 : -1;
+        if (!in_level(n, nb)) continue;
+        if (const int32_t id = out.pocket[out.voxel(l, nb)]; id >= 0) out.pocket_glows[size_t(id)] = 1;
+      }
+    }
+  }
+}
+
+// The pockets holding a point light (conservatively: any pocket within a
+// voxel of it on some level) or glowing are lit.
+std::vector<uint8_t> lit_pockets(const std::vector<PointLight>& lights, const GiLayout& out) {
+  std::vector<uint8_t> lit = out.pocket_glows;
+  for (const PointLight& light : lights) {
+    for (int l = 0; l < out.k; ++l) {
+      const double size = double(out.params.fparams.x) * double(1 << l);
+      const glm::ivec3 c =
+          glm::ivec3(glm::floor((light.position - out.origin) / size)) - glm::ivec3(out.params.lo[l]);
+      for (int z = -1; z <= 1; ++z)
+        for (int y = -1; y <= 1; ++y)
+          for (int x = -1; x <= 1; ++x) {
+            const glm::ivec3 nb = c + glm::ivec3(x, y, z);
+            if (!in_level(out.n, nb)) continue;
+            if (const int32_t id = out.pocket[out.voxel(l, nb)]; id >= 0) lit[size_t(id)] = 1;
+          }
+    }
+  }
+  return lit;
+}
+
+// Dark voxels (kVoxelDark): sealed air of an unlit pocket, and the solid
+// voxels all of whose air neighbours are (at least one); a coarser voxel
+// covered by the finer level is dark when its eight children are. Returns
+// whether any voxel's flag changed.
+bool mark_dark(const std::vector<PointLight>& lights, GiLayout& out) {
+  std::vector<uint8_t> lit = lit_pockets(lights, out);
+  if (lit == out.pocket_lit) return false;  // set_lights: the lights moved within their pockets (the common case)
+  out.pocket_lit = std::move(lit);
+  const int n = out.n;
+  std::vector<uint8_t> dark(out.voxels(), 0);
+  for (size_t v = 0; v < dark.size(); ++v) dark[v] = out.pocket[v] >= 0 && !out.pocket_lit[size_t(out.pocket[v])];
+  for (int l = 0; l < out.k; ++l)
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          const glm::ivec3 c(x, y, z);
+          const size_t v = out.voxel(l, c);
+          if (out.pocket[v] >= 0 || voxel_flag(out.vmap[v], kVoxelOpen)) continue;  // sealed air, or open
+          int air = 0, dark_air = 0;
+          for (int f = 0; f < kFaces; ++f) {
+            glm::ivec3 nb = c;
+            nb[face_axis(f)] += face_positive(f) ? 1 : -1;
+            if (!in_level(n, nb) || out.pocket[out.voxel(l, nb)] < 0) continue;
+            ++air;
+            dark_air += dark[out.voxel(l, nb)];
+          }
+          dark[v] = air > 0 && dark_air == air;
+        }
+  for (int l = 0; l + 1 < out.k; ++l) {
+    const glm::ivec3 fine_lo(out.params.lo[l]), coarse_lo(out.params.lo[l + 1]);
+    for (int z = 0; z < n; ++z)
+      for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+          const glm::ivec3 child0 = 2 * (coarse_lo + glm::ivec3(x, y, z)) - fine_lo;
+          if (!in_level(n, child0) || !in_level(n, child0 + 1)) continue;
+          uint8_t all = 1;
+          for (int k = 0; k < 8; ++k) all &= dark[out.voxel(l, child0 + glm::ivec3(k & 1, (k >> 1) & 1, k >> 2))];
+          dark[out.voxel(l + 1, {x, y, z})] = all;
+        }
+  }
+  bool changed = false;
+  for (size_t v = 0; v < dark.size(); ++v) {
+    const int32_t before = out.vmap[v];
+    set_voxel_flag(out.vmap[v], kVoxelDark, dark[v] != 0);
+    changed = changed || out.vmap[v] != before;
+  }
+  return changed;
 }
 
 }  // namespace
@@ -393,8 +538,10 @@ Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& light
   out.level_count.assign(size_t(out.k), 0);
   out.level_shadow.assign(size_t(out.k), 0);
   for (int l = 0; l < out.k; ++l) add_level(packed, l, cascades.level_valid(l), out);
-  mark_sky_open(cascades, out);
+  const std::vector<std::vector<uint8_t>> open = mark_sky_open(cascades, out);
   fill_params(cascades, lights, config, out);  // after the opacities: injection reads them
+  label_pockets(cascades, open, out);
+  mark_dark(lights.points, out);
   return out;
 }
 
@@ -415,6 +562,9 @@ Status GiEngineBase::set_lights(const GiLights& lights) {
   if (!loaded_) return Status(ErrorCode::kInvalidArgument, "gi: load() the cascades first");
   if (Status s = check_gi_lights(lights, config_); !s.ok()) return s;
   fill_light_params(lights, config_, layout_);
+  if (mark_dark(lights.points, layout_)) {  // a light went into a sealed pocket, or left one
+    if (Status s = upload_vmap(layout_); !s.ok()) return s;
+  }
   return upload_lights(layout_);
 }
 

@@ -64,6 +64,7 @@ class VulkanGi final : public GiEngineBase {
  protected:
   Status upload(const GiLayout& layout) override;
   Status upload_lights(const GiLayout& layout) override;
+  Status upload_vmap(const GiLayout& layout) override;
   Status run_steps(const std::vector<GiStep>& steps) override;
   Status set_queries(const std::vector<glm::vec4>& qin) override;
   Status get_queries(std::vector<glm::vec4>& qout, size_t count) override;
@@ -384,6 +385,13 @@ Status VulkanGi::upload_lights(const GiLayout& layout) {
   std::memcpy(buffers_[0].mapped, &layout.params, sizeof(GiParams));
   if (bytes(layout.light_volume) > buffers_[12].size) return Status(ErrorCode::kInternal, "gi: light volume grew");
   std::memcpy(buffers_[12].mapped, layout.light_volume.data(), size_t(bytes(layout.light_volume)));
+  return {};
+}
+
+Status VulkanGi::upload_vmap(const GiLayout& layout) {
+  // As upload_lights: no kernel is reading it now.
+  if (bytes(layout.vmap) > buffers_[3].size) return Status(ErrorCode::kInternal, "gi: voxel map grew");
+  std::memcpy(buffers_[3].mapped, layout.vmap.data(), size_t(bytes(layout.vmap)));
   return {};
 }
 

@@ -44,6 +44,10 @@ struct GiStep {
   int first = 0, count = 0, level = 0;
 };
 
+// vmap's flags (gi_common.glsl's vmap_flags): less than half solid, sealed
+// from the sky with no light inside, open to the sky.
+constexpr int32_t kVoxelAir = 1, kVoxelDark = 2, kVoxelOpen = 4;
+
 struct GiLayout {
   GiParams params{};
   int n = 0, k = 0;
@@ -54,6 +58,9 @@ struct GiLayout {
   std::vector<glm::vec4> attr;        // S * 18
   std::vector<int32_t> face_src;      // S * 6: light slot (s * 6 + face) a face shows, or -1
   std::vector<glm::vec4> light_volume;  // K N^3 injected point lights (GiConfig::light_volume), else empty
+  std::vector<int32_t> pocket;          // K N^3: sealed air's pocket (numbered over all levels), or -1
+  std::vector<uint8_t> pocket_glows;    // per pocket: an emissive face looks into it
+  std::vector<uint8_t> pocket_lit;      // per pocket: glows or holds a point light (as vmap's dark flags say)
   // Per level the entries start at level_first: level_count surface voxels
   // (updated), then level_shadow voxels that only show their neighbours'
   // light on propagated faces (precombined, never updated).
@@ -86,6 +93,8 @@ class GiEngineBase : public GiEngine {
   virtual Status upload(const GiLayout& layout) = 0;
   // Replaces the uniform block and the light volume (set_lights).
   virtual Status upload_lights(const GiLayout& layout) = 0;
+  // Replaces the voxel map (set_lights, when a sealed pocket's darkness changed).
+  virtual Status upload_vmap(const GiLayout& layout) = 0;
   // Runs the steps in order, each seeing what the ones before wrote (the
   // Vulkan engine records them in one command buffer: one submit), and
   // sets last_device_seconds_ (GiTimings::device_seconds) and

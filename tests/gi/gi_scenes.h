@@ -70,13 +70,15 @@ inline Cascades make_cascades(const World& world, const glm::dvec3& camera, int 
   return std::move(cas).value();
 }
 
-// A closed room: walls 1.6 m thick around the inside [-0.8, 0.8]^3. Thick,
-// because cones see a wall through coarse voxels once they are as wide as
-// the room: with 0.4 m walls around a 2.4 m room the coarsest level (0.8 m
-// voxels) holds them at half opacity and 23% of the sky leaks in (the
-// talk's "cone tracing is only a rough estimate").
-inline std::vector<GiBox> closed_room(uint16_t wall_material = 0) {
-  const double a = 0.8, b = 2.4;
+// A closed room: walls around the inside [-0.8, 0.8]^3 out to `outer`
+// (1.6 m thick by default). Thick, because cones see a wall through coarse
+// voxels once they are as wide as the room: with 0.4 m walls around a 2.4 m
+// room the coarsest level (0.8 m voxels) holds them at half opacity (the
+// talk's "cone tracing is only a rough estimate"). The sealed-pocket rule
+// (gi_common.glsl's point_dark) keeps such a room black under the sky
+// alone whatever its walls; a light inside still sees the leak.
+inline std::vector<GiBox> closed_room(uint16_t wall_material = 0, double outer = 2.4) {
+  const double a = 0.8, b = outer;
   return {{{-b, -b, -b}, {b, b, -a}, wall_material}, {{-b, -b, a}, {b, b, b}, wall_material},
           {{-b, -b, -b}, {-a, b, b}, wall_material}, {{a, -b, -b}, {b, b, b}, wall_material},
           {{-b, -b, -b}, {b, -a, b}, wall_material}, {{-b, a, -b}, {b, b, b}, wall_material}};
