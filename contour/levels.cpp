@@ -36,6 +36,7 @@
 #include <tbb/parallel_for.h>
 
 #include "contour/contour.h"
+#include "contour/detail/cell_sheets.h"
 #include "contour/detail/placement.h"
 #include "contour/detail/region.h"
 #include "ldc/lod.h"
@@ -503,7 +504,13 @@ class ChunkMesher {
     out = ChunkPart();
     chunk_ = chunk;
     finer_neighbour_ = has_finer_neighbour(chunk, levels_->at(chunk));
-    for (const Cell& cell : candidate_cells(chunk)) mesh_cell(cell, true, out);
+    const std::vector<Cell> cells = candidate_cells(chunk);
+    // About a vertex, an owned edge and five quadrant keys per cell: growing
+    // these by doubling cost a tenth of a level-0 chunk in copies and page faults.
+    out.vertices.reserve(cells.size());
+    out.edges.reserve(cells.size());
+    out.keys.reserve(6 * cells.size());
+    for (const Cell& cell : cells) mesh_cell(cell, true, out);
     std::sort(out.keys.begin(), out.keys.end());
   }
 
@@ -600,13 +607,52 @@ class ChunkMesher {
 
   // The cell's sheets under the default rule; false when it has no crossing.
   bool default_sheets(const Cell& cell, CellShape& shape) {
-    build_pieces(*levels_, chunk_size_, cell, is_plain(cell), shape);
+    const bool plain = is_plain(cell);
+    if (plain) {
+      if (const int found = plain_sheets(cell, shape); found >= 0) return found == 1;
+    }
+    build_pieces(*levels_, chunk_size_, cell, plain, shape);
     if (!read_crossings(reader_, shape)) return false;
     no_joins_.assign(shape.pieces.size(), 0);
     trace_sheets(shape, no_joins_);
     return true;
   }
 
+
+  // A plain cell's sheets (six whole faces, as in the uniform mesher) from
+  // the uniform mesher's table: 8 corner reads and 12 edges, where the
+  // pieces' way reads 24 nodes and traces their loops (that way costs a
+  // level-0 chunk about 2.5 times contour_world's). 1: sheets found; 0: no
+  // crossing, or an edge with none to read (as read_crossings); -1: a face
+  // has both its segments on one sheet, so the cell across may ask for a
+  // join, which the pieces' way decides.
+  int plain_sheets(const Cell& cell, CellShape& shape) {
+    const int s = cell.size();
+    unsigned inside = 0;
+    for (int c = 0; c < 8; ++c)
+      if (reader_.inside(cell.lo + s * glm::ivec3(c & 1, (c >> 1) & 1, c >> 2))) inside |= 1u << c;
+    if (inside == 0 || inside == 255) return 0;
+    for (int face = 0; face < 6; ++face)
+      if (detail::face_links_both_segments(inside, face)) return -1;
+    const detail::CellSheets& table = detail::cell_sheets(inside);
+    shape.cell = cell;
+    shape.nodes.clear();
+    shape.pieces.clear();
+    shape.crossings.clear();
+    for (int slot = 0; slot < 12; ++slot) {
+      if (table.sheet_of_edge[slot] < 0) continue;
+      CellCrossing c;
+      c.axis = detail::cell_edge_axis(slot);
+      c.lower = cell.lo + s * detail::cell_edge_offset(slot);
+      c.level = cell.level;
+      c.x = reader_.crossing(c.lower, c.axis, c.level);
+      if (!c.x) return 0;
+      c.sheet = table.sheet_of_edge[slot];
+      shape.crossings.push_back(c);
+    }
+    shape.sheets = table.count;
+    return 1;
+  }
 
   LevelVertex place(int sheet) {
     const Cell& cell = shape_.cell;
@@ -821,22 +867,31 @@ class ChunkAndNeighbours {
   ChunkPart scratch_;
 };
 
+// The parts' vertices (numbered from their first_vertex) and triangles in
+// one mesh, filled in parallel at each part's offsets.
 ContourMesh assemble(const World& world, const std::vector<ChunkPart>& parts,
                      const std::vector<std::vector<glm::uvec3>>& tris,
                      const std::vector<std::vector<uint16_t>>& mats) {
+  std::vector<size_t> first_triangle(parts.size() + 1, 0);
+  for (size_t i = 0; i < parts.size(); ++i) first_triangle[i + 1] = first_triangle[i] + tris[i].size();
+  const size_t vertices = parts.empty() ? 0 : parts.back().first_vertex + parts.back().vertices.size();
   ContourMesh mesh;
+  mesh.positions.resize(vertices);
+  mesh.normals.resize(vertices);
+  mesh.vertex_material.resize(vertices);
+  mesh.triangles.resize(first_triangle.back());
+  mesh.triangle_material.resize(first_triangle.back());
   const Lattice& lattice = world.lattice();
-  for (const ChunkPart& part : parts) {
-    for (const LevelVertex& v : part.vertices) {
-      mesh.positions.push_back(lattice.to_world(v.x));
-      mesh.normals.push_back(v.normal);
-      mesh.vertex_material.push_back(v.material);
+  tbb::parallel_for(size_t{0}, parts.size(), [&](size_t i) {
+    size_t k = parts[i].first_vertex;
+    for (const LevelVertex& v : parts[i].vertices) {
+      mesh.positions[k] = lattice.to_world(v.x);
+      mesh.normals[k] = v.normal;
+      mesh.vertex_material[k++] = v.material;
     }
-  }
-  for (size_t i = 0; i < parts.size(); ++i) {
-    mesh.triangles.insert(mesh.triangles.end(), tris[i].begin(), tris[i].end());
-    mesh.triangle_material.insert(mesh.triangle_material.end(), mats[i].begin(), mats[i].end());
-  }
+    std::copy(tris[i].begin(), tris[i].end(), mesh.triangles.begin() + std::ptrdiff_t(first_triangle[i]));
+    std::copy(mats[i].begin(), mats[i].end(), mesh.triangle_material.begin() + std::ptrdiff_t(first_triangle[i]));
+  });
   return mesh;
 }
 
