@@ -433,7 +433,7 @@ void kernel_cones(int gid) {
   ConeResult cr = trace_cone(voxel_centre(sp.w, IXYZ(sp)), dir, sp.w, far_start(sp.w));
   int slot = (s * 16 + dir) * 3;
   cone_store(slot + 0, vec4(cr.src, cr.sky));
-  cone_store(slot + 1, vec4(cr.d, 0.0f));
+  cone_store(slot + 1, vec4(cr.d, cr.transmittance));
   cone_store(slot + 2, vec4(cr.b1, 0.0f));
 }
 
@@ -485,6 +485,14 @@ bool point_dark(int l, vec3 p) {
   return air;
 }
 
+// A cone from sealed air (open = 0) must end on the pocket's walls, but
+// the cascades let it through thin walls at coarse levels with light left
+// (transmittance T): it then saw 1 - T of its walls. Its light is scaled by
+// 1 / (1 - T), as if the rest were walls like those it saw (at most 4
+// times: a cone that saw under a quarter is not extrapolated further).
+// Cones from open air keep T for the sky.
+float sealed_gain(float open, float T) { return open > 0.0f ? 1.0f : 1.0f / max(1.0f - T, 0.25f); }
+
 // Kernel 3: the second half of a lighting update of surface voxels
 // pc.first .. + pc.count, after kernel 5 traced their 16 cones: direct
 // light (sky, point lights, emission), first bounce (from D) and second
@@ -529,17 +537,20 @@ void kernel_update(int gid) {
       if (c <= 0.0f) continue;
       vec4 far_src = cone_load((s * 16 + i) * 3 + 0);
       vec3 src = XYZ(far_src) + (open * far_src.w) * XYZ(P.sky[i]);
-      vec3 gd = XYZ(cone_load((s * 16 + i) * 3 + 1));
+      vec4 far_d = cone_load((s * 16 + i) * 3 + 1);
+      vec3 gd = XYZ(far_d);
       vec3 gb1 = XYZ(cone_load((s * 16 + i) * 3 + 2));
       if (split) {
         ConeResult nr = trace_cone_range(apex_f, i, l, 0.5f * vs, ts - 0.5f * vs * c);
-        es += c * (nr.src + (open * nr.sky) * XYZ(P.sky[i]) + nr.transmittance * src);
-        ed += c * (nr.d + nr.transmittance * gd);
-        eb += c * (nr.b1 + nr.transmittance * gb1);
+        float w = c * sealed_gain(open, nr.transmittance * far_d.w);
+        es += w * (nr.src + (open * nr.sky) * XYZ(P.sky[i]) + nr.transmittance * src);
+        ed += w * (nr.d + nr.transmittance * gd);
+        eb += w * (nr.b1 + nr.transmittance * gb1);
       } else {
-        es += c * src;
-        ed += c * gd;
-        eb += c * gb1;
+        float w = c * sealed_gain(open, far_d.w);
+        es += w * src;
+        ed += w * gd;
+        eb += w * gb1;
       }
     }
     vec3 rho = XYZ(albedo) / wsum;
@@ -587,7 +598,7 @@ void kernel_query(int gid) {
     vec3 l = cr.src + (open * cr.sky) * XYZ(P.sky[i]) + cr.d;
     if (bounces >= 2) l += cr.b1;
     if (bounces >= 3) l += cr.b2 + third_bounce(cr.b1, cr.b2);
-    e += c * l;
+    e += (c * sealed_gain(open, cr.transmittance)) * l;
   }
   vec3 lights = point_light_irradiance(p, n, 0.5f * s, light_visibility(apex, l0, 0.5f * s));
   qout_store(q, vec4(e * (kPi / wsum) + lights, float(l0)));
