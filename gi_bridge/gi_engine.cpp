@@ -280,14 +280,31 @@ size_t level_local_index(int n, const glm::ivec3& c) {
   return (size_t(c.z) * size_t(n) + size_t(c.y)) * size_t(n) + size_t(c.x);
 }
 
+bool in_level(int n, const glm::ivec3& c) {
+  return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n)));
+}
+
+// Floods a level's N^3 block from the voxels on `stack` through their six
+// face neighbours: enter(c) marks a neighbour and says whether it joined.
+template <class Enter>
+void flood_faces(int n, std::vector<glm::ivec3>& stack, Enter&& enter) {
+  while (!stack.empty()) {
+    const glm::ivec3 c = stack.back();
+    stack.pop_back();
+    for (int f = 0; f < kFaces; ++f) {
+      glm::ivec3 nb = c;
+      nb[face_axis(f)] += face_positive(f) ? 1 : -1;
+      if (in_level(n, nb) && enter(nb)) stack.push_back(nb);
+    }
+  }
+}
+
 std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vector<uint8_t>* coarser,
                                  const GiLayout& out) {
   const int n = out.n;
   const VoxelBox box = cascades.level_box(l);
   const auto local = [n](const glm::ivec3& c) { return level_local_index(n, c); };
-  const auto inside = [n](const glm::ivec3& c) {
-    return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n)));
-  };
+  const auto inside = [n](const glm::ivec3& c) { return in_level(n, c); };
   std::vector<uint8_t> passable(size_t(n) * size_t(n) * size_t(n)), open(passable.size(), 0);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
@@ -308,17 +325,11 @@ std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vec
         }
         if (seed) open[local(c)] = 1, stack.push_back(c);
       }
-  while (!stack.empty()) {
-    const glm::ivec3 c = stack.back();
-    stack.pop_back();
-    for (int f = 0; f < kFaces; ++f) {
-      glm::ivec3 nb = c;
-      nb[face_axis(f)] += face_positive(f) ? 1 : -1;
-      if (!inside(nb) || !passable[local(nb)] || open[local(nb)]) continue;
-      open[local(nb)] = 1;
-      stack.push_back(nb);
-    }
-  }
+  flood_faces(n, stack, [&](const glm::ivec3& nb) {
+    if (!passable[local(nb)] || open[local(nb)]) return false;
+    open[local(nb)] = 1;
+    return true;
+  });
   std::vector<uint8_t> flag = open;  // solid voxels: open where open air touches them
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
@@ -385,10 +396,6 @@ std::vector<std::vector<uint8_t>> mark_sky_open(const Cascades& cascades, GiLayo
   return flags;
 }
 
-bool in_level(int n, const glm::ivec3& c) {
-  return glm::all(glm::greaterThanEqual(c, glm::ivec3(0))) && glm::all(glm::lessThan(c, glm::ivec3(n)));
-}
-
 // Sealed air (issue 25): the voxels the sky flood did not reach, less than
 // half solid, in 6-connected pockets numbered across all levels
 // (GiLayout::pocket), and which pockets an emissive face looks into
@@ -413,17 +420,11 @@ void label_pockets(const Cascades& cascades, const std::vector<std::vector<uint8
           const int32_t id = pockets++;
           out.pocket[first + level_local_index(n, {x, y, z})] = id;
           stack.assign(1, glm::ivec3(x, y, z));
-          while (!stack.empty()) {
-            const glm::ivec3 c = stack.back();
-            stack.pop_back();
-            for (int f = 0; f < kFaces; ++f) {
-              glm::ivec3 nb = c;
-              nb[face_axis(f)] += face_positive(f) ? 1 : -1;
-              if (!in_level(n, nb) || !sealed_air(nb)) continue;
-              out.pocket[first + level_local_index(n, nb)] = id;
-              stack.push_back(nb);
-            }
-          }
+          flood_faces(n, stack, [&](const glm::ivec3& nb) {
+            if (!sealed_air(nb)) return false;
+            out.pocket[first + level_local_index(n, nb)] = id;
+            return true;
+          });
         }
   }
   out.pocket_glows.assign(size_t(pockets), 0);

@@ -84,6 +84,29 @@ inline std::vector<GiBox> closed_room(uint16_t wall_material = 0, double outer =
           {{-b, -b, -b}, {b, -a, b}, wall_material}, {{-b, a, -b}, {b, b, b}, wall_material}};
 }
 
+
+// The CPU engine's irradiance at five points on the inside walls of a
+// glowing closed room (closed_room(2, ...): emission 4, albedo 0.7) over
+// the exact furnace value 4 pi (1 + 0.7 + 0.49 ...), after 1, 2 and 3
+// bounces: ratio[bounces - 1][point].
+inline std::vector<std::vector<float>> furnace_ratios(const World& world) {
+  const Cascades cas = make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  EXPECT_TRUE(gi->load(cas, GiLights{}).ok());
+  EXPECT_TRUE(gi->update_all(3).ok());
+  const std::vector<glm::dvec3> p = {{0, 0, -0.8}, {0.3, -0.2, 0.8}, {0.8, 0.3, 0.2}, {-0.5, 0.8, -0.5}, {-0.6, -0.6, -0.8}};
+  const std::vector<glm::vec3> n = {{0, 0, 1}, {0, 0, -1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, 1}};
+  std::vector<std::vector<float>> ratio;
+  for (int b = 1; b <= 3; ++b) {
+    std::vector<glm::vec3> e(p.size());
+    EXPECT_TRUE(gi->irradiance(p, n, b, e).ok());
+    const float exact = 4.0f * 3.14159265f * (b == 1 ? 1.0f : b == 2 ? 1.7f : 2.19f);
+    ratio.emplace_back();
+    for (const glm::vec3& v : e) ratio.back().push_back((v.r + v.g + v.b) / 3.0f / exact);
+  }
+  return ratio;
+}
+
 }  // namespace ldc::test
 
 namespace ldc::test {
