@@ -304,7 +304,6 @@ std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vec
   const int n = out.n;
   const VoxelBox box = cascades.level_box(l);
   const auto local = [n](const glm::ivec3& c) { return level_local_index(n, c); };
-  const auto inside = [n](const glm::ivec3& c) { return in_level(n, c); };
   std::vector<uint8_t> passable(size_t(n) * size_t(n) * size_t(n)), open(passable.size(), 0);
   for (int z = 0; z < n; ++z)
     for (int y = 0; y < n; ++y)
@@ -321,7 +320,7 @@ std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vec
         bool seed = coarser == nullptr;
         if (coarser) {
           const glm::ivec3 parent = ((box.lo + c) >> 1) - up.lo;  // arithmetic shift: floor(g / 2)
-          seed = !inside(parent) || (*coarser)[local(parent)];
+          seed = !in_level(n, parent) || (*coarser)[local(parent)];
         }
         if (seed) open[local(c)] = 1, stack.push_back(c);
       }
@@ -339,7 +338,7 @@ std::vector<uint8_t> flood_level(const Cascades& cascades, int l, const std::vec
         for (int f = 0; f < kFaces && !flag[local(c)]; ++f) {
           glm::ivec3 nb = c;
           nb[face_axis(f)] += face_positive(f) ? 1 : -1;
-          flag[local(c)] = inside(nb) && open[local(nb)];
+          flag[local(c)] = in_level(n, nb) && open[local(nb)];
         }
       }
   return flag;
@@ -375,9 +374,9 @@ void set_voxel_flag(int32_t& v, int32_t flag, bool on) {
 }
 bool voxel_flag(int32_t v, int32_t flag) { return ((v < 0 ? -1 - v : (v >> 28) & 7) & flag) != 0; }
 
-// Writes the flags into vmap (kVoxelOpen; kVoxelAir where less than half
-// solid) and returns them, per level.
-std::vector<std::vector<uint8_t>> mark_sky_open(const Cascades& cascades, GiLayout& out) {
+// Writes the flags into vmap: kVoxelOpen, and kVoxelAir where less than
+// half solid.
+void mark_sky_open(const Cascades& cascades, GiLayout& out) {
   std::vector<std::vector<uint8_t>> flags(size_t(out.k));
   for (int l = out.k - 1; l >= 0; --l)
     flags[size_t(l)] = flood_level(cascades, l, l + 1 < out.k ? &flags[size_t(l) + 1] : nullptr, out);
@@ -393,25 +392,23 @@ std::vector<std::vector<uint8_t>> mark_sky_open(const Cascades& cascades, GiLayo
       if (cascades.occupancy(l, box.lo + c) < 0.5f) set_voxel_flag(v, kVoxelAir, true);
     }
   }
-  return flags;
 }
 
-// Sealed air (issue 25): the voxels the sky flood did not reach, less than
-// half solid, in 6-connected pockets numbered across all levels
+// Sealed air (issue 25): the air voxels (kVoxelAir) the sky flood did not
+// reach (no kVoxelOpen), in 6-connected pockets numbered across all levels
 // (GiLayout::pocket), and which pockets an emissive face looks into
 // (pocket_glows). Light cannot get into a pocket through its walls; with
 // no light source inside, everything in it is black (see mark_dark).
-void label_pockets(const Cascades& cascades, const std::vector<std::vector<uint8_t>>& open, GiLayout& out) {
+void label_pockets(GiLayout& out) {
   const int n = out.n;
   out.pocket.assign(out.voxels(), -1);
   int32_t pockets = 0;
   std::vector<glm::ivec3> stack;
   for (int l = 0; l < out.k; ++l) {
-    const VoxelBox box = cascades.level_box(l);
     const size_t first = out.voxel(l, glm::ivec3(0));
     auto sealed_air = [&](const glm::ivec3& c) {
-      const size_t i = level_local_index(n, c);
-      return !open[size_t(l)][i] && out.pocket[first + i] < 0 && cascades.occupancy(l, box.lo + c) < 0.5f;
+      const size_t v = first + level_local_index(n, c);
+      return out.pocket[v] < 0 && voxel_flag(out.vmap[v], kVoxelAir) && !voxel_flag(out.vmap[v], kVoxelOpen);
     };
     for (int z = 0; z < n; ++z)
       for (int y = 0; y < n; ++y)
@@ -539,9 +536,9 @@ Result<GiLayout> build_gi_layout(const Cascades& cascades, const GiLights& light
   out.level_count.assign(size_t(out.k), 0);
   out.level_shadow.assign(size_t(out.k), 0);
   for (int l = 0; l < out.k; ++l) add_level(packed, l, cascades.level_valid(l), out);
-  const std::vector<std::vector<uint8_t>> open = mark_sky_open(cascades, out);
+  mark_sky_open(cascades, out);
   fill_params(cascades, lights, config, out);  // after the opacities: injection reads them
-  label_pockets(cascades, open, out);
+  label_pockets(out);
   mark_dark(lights.points, out);
   return out;
 }

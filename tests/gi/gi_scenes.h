@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -105,6 +106,16 @@ inline std::vector<std::vector<float>> furnace_ratios(const World& world) {
     for (const glm::vec3& v : e) ratio.back().push_back((v.r + v.g + v.b) / 3.0f / exact);
   }
   return ratio;
+}
+
+// Checks furnace_ratios: above low[bounces - 1] and under 1.02 at every point.
+inline void expect_furnace_ratios(const std::vector<std::vector<float>>& ratio, const std::array<float, 3>& low) {
+  for (int b = 1; b <= 3; ++b) {
+    for (size_t i = 0; i < ratio[size_t(b - 1)].size(); ++i) {
+      EXPECT_GT(ratio[size_t(b - 1)][i], low[size_t(b - 1)]) << "bounces " << b << ", point " << i;
+      EXPECT_LT(ratio[size_t(b - 1)][i], 1.02f) << "bounces " << b << ", point " << i;
+    }
+  }
 }
 
 }  // namespace ldc::test
