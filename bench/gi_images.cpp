@@ -11,7 +11,8 @@
 // (the closed room with the sky outside) report the cone tracer's mean
 // radiance instead, which must be 0. With DIR, each view is written as
 // DIR/gi_<view>.png: the cone tracer (CPU engine) on the left, the
-// reference on the right.
+// reference on the right. BENCH_GI_VIEW picks views by substring and
+// BENCH_GI_BOUNCES=1 or 2 compares the first bounces alone (both sides).
 #include "gi_images.h"
 #include "scene_builders.h"
 
@@ -72,6 +73,13 @@ MaterialTable room_materials(float emission) {
 
 SkyLight default_sky() { return SkyLight::gradient(glm::vec3(1.0f, 1.2f, 1.6f), glm::vec3(1.4f), glm::vec3(0.3f)); }
 
+// BENCH_GI_BOUNCES: 1 or 2 to compare the first bounces alone (both sides), 3 when unset.
+int bounces() {
+  const char* b = std::getenv("BENCH_GI_BOUNCES");
+  const int n = b ? std::atoi(b) : 3;
+  return n >= 1 && n <= 3 ? n : 3;
+}
+
 float lum(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 struct ImageError {
@@ -127,9 +135,9 @@ Result<Reference> reference(const View& v, const std::vector<Ray>& rays, int pat
   r.hit.resize(rays.size());
   PathTraceConfig pc;
   pc.samples = paths;
-  if (Status s = pt.value()->radiance_along(rays, 3, a, pc, r.hit); !s.ok()) return s;
+  if (Status s = pt.value()->radiance_along(rays, bounces(), a, pc, r.hit); !s.ok()) return s;
   pc.seed = 2;
-  if (Status s = pt.value()->radiance_along(rays, 3, b, pc); !s.ok()) return s;
+  if (Status s = pt.value()->radiance_along(rays, bounces(), b, pc); !s.ok()) return s;
   r.noise = compare(b, a, r.hit).l1;
   r.mean.resize(rays.size());
   for (size_t i = 0; i < rays.size(); ++i) r.mean[i] = 0.5f * (a[i] + b[i]);
@@ -147,7 +155,7 @@ Result<RadianceImage> cone_image(const View& v, const Camera& cam, GiEngine& gi)
   if (Status s = gi.load(cas.value(), v.lights); !s.ok()) return s;
   if (Result<GiTimings> t = gi.update_all(3); !t.ok()) return t.status();
   Queries queries(*v.world);
-  return render_gi(queries, cam, gi, {.materials = v.materials, .sky = v.lights.sky, .bounces = 3});
+  return render_gi(queries, cam, gi, {.materials = v.materials, .sky = v.lights.sky, .bounces = bounces()});
 }
 
 Result<Camera> view_camera(const View& v) {
@@ -377,9 +385,9 @@ void gi_images(int paths, const char* dir, bool with_vulkan) {
     return;
   }
   std::printf("\n## Whole images against the path tracer (issue 25)\n");
-  std::printf("%d x %d pixels, 3 bounces, cascades of 6 levels of 32^3 voxels of 2 h centred on the camera, 3 passes; "
+  std::printf("%d x %d pixels, %d bounces, cascades of 6 levels of 32^3 voxels of 2 h centred on the camera, 3 passes; "
               "reference: mean of 2 path-traced images of %d paths per pixel (seeds 1, 2)\n",
-              kWidth, kHeight, paths);
+              kWidth, kHeight, bounces(), paths);
   std::printf("| view | engine | rel. L1 | rel. L1, darkest fifth | brightness | reference noise (seed 2 vs 1) | paths |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   for (const View& v : sc.value()->views)
