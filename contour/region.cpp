@@ -75,7 +75,9 @@ void Region::load_tile(int axis, int tu, int tv) {
       for (; at < ray; ++at)  // rays between every stride-th one (none at stride 1)
         for (int k = 0; k < span; ++k)
           if (fam[k]) offset[k] += fam[k]->point_count(at);
-      bool state = fam[0] ? fam[0]->starts_inside(ray) : uniform_inside[0];
+      bool state = fam[0] ? fam[0]->starts_inside(ray, std::span<const PackedPoint>(fam[0]->all_points().data() + offset[0],
+                                                                                   fam[0]->point_count(ray)))
+                          : uniform_inside[0];
       pts.clear();
       for (int k = 0; k < span; ++k) {
         if (!fam[k]) continue;

@@ -19,12 +19,7 @@ bool apply_op(BooleanOp op, bool a, bool b) {
 }
 
 // One ray segment of a chunk family, read-only.
-struct RaySegment {
-  bool starts_inside;
-  std::span<const PackedPoint> points;
-};
-
-RaySegment segment(const RayFamily& f, int ray) { return {f.starts_inside(ray), f.points(ray)}; }
+using RaySegment = RayPoints;
 
 // Flips a point's sense and turns its normal around (a cutter surface that a
 // difference exposes faces the other way).
@@ -140,7 +135,8 @@ void note_ray_change(const RaySegment& a, const RaySegment& out, int axis, int r
 
 void note_family_change(const RayFamily& a, const RayFamily& out, int axis, int c, ChangeBox& box) {
   if (a.is_uniform() && out.is_uniform() && a.uniform_inside() == out.uniform_inside()) return;
-  for (int r = 0; r < c * c; ++r) note_ray_change(segment(a, r), segment(out, r), axis, r, c, box);
+  RayReader ra(a), rout(out);
+  for (int r = 0; r < c * c; ++r) note_ray_change(ra.next(), rout.next(), axis, r, c, box);
 }
 
 // The family of a chunk view on one axis (uniform families for uniform chunks).
@@ -154,8 +150,9 @@ RayFamily merge_family(const RayFamily& a, const RayFamily& b, BooleanOp op, con
   const uint32_t q = depth_steps_per_cell(c);
   SliverFilter filter(uint32_t(config.sliver * q), q);
   RayFamilyWriter wr(c);
+  RayReader ra(a), rb(b);
   for (int r = 0; r < c * c; ++r) {
-    RaySegment sa = segment(a, r), sb = segment(b, r);
+    RaySegment sa = ra.next(), sb = rb.next();
     wr.begin_ray(apply_op(op, sa.starts_inside, sb.starts_inside));
     if (sb.points.empty() && sa.points.empty()) continue;
     merge_ray(sa, sb, op, config.cut_material, filter);
@@ -235,10 +232,12 @@ MergedChunk paint_chunk(const ChunkView& a, const ChunkView& b, uint16_t materia
     if (fa.is_uniform() || (fb.is_uniform() && !fb.uniform_inside())) continue;  // nothing to paint
     RayFamilyWriter wr(c);
     bool changed = false;
+    RayReader ra(fa), rb(fb);
     for (int r = 0; r < c * c; ++r) {
-      wr.begin_ray(fa.starts_inside(r));
-      StateWalker inside_b(segment(fb, r));
-      for (PackedPoint p : fa.points(r)) {
+      const RaySegment own = ra.next();
+      wr.begin_ray(own.starts_inside);
+      StateWalker inside_b(rb.next());
+      for (PackedPoint p : own.points) {
         if (inside_b.at(p.depth) && p.material != material) {
           p.material = material;
           changed = true;

@@ -77,12 +77,10 @@ void mark_inside_cells(const Chunk* own, ChunkKind kind, CellIndex* index) {
     return;
   }
   const RayFamily& xs = own->axis[0];
-  std::span<const PackedPoint> all = xs.all_points();
-  uint32_t offset = 0;
+  RayReader rays(xs);
   for (int ray = 0; ray < c * c; ++ray) {  // X rays: ray = z*C + y
-    const uint32_t n = xs.point_count(ray);
-    const uint64_t word = node_word(xs.starts_inside(ray), all.subspan(offset, n), c);
-    offset += n;
+    const RayPoints points = rays.next();
+    const uint64_t word = node_word(points.starts_inside, points.points, c);
     if (!word) continue;
     const int y = ray % c, z = ray / c;
     for (int bx = 0; bx < index->bricks_per_axis; ++bx) {
@@ -212,11 +210,12 @@ void gather_edge(const World& world, const glm::ivec3& node, int axis, const glm
   if (!data) return;
   const RayFamily& family = data->axis[axis];
   const int ray = ray_index(node, axis, c);
-  const uint32_t n = family.point_count(ray);
-  if (!n) return;
+  if (!family.holds_points(ray)) return;
+  uint32_t n = 0;
+  const uint32_t first = family.first_point(ray, std::span<uint32_t>(&n, 1));
   const uint32_t q = depth_steps_per_cell(c);
   const uint32_t lo = uint32_t(node[axis] - ch[axis] * c) * q;
-  add_edge_points(family, family.first_point(ray), n, lo, lo + q, glm::dvec3(node - cell), axis, out);
+  add_edge_points(family, first, n, lo, lo + q, glm::dvec3(node - cell), axis, out);
 }
 
 // The common case: all twelve edges lie in the cell's own chunk, so the four
@@ -230,9 +229,10 @@ void gather_inner_cell(const Chunk& chunk, int c, const glm::ivec3& local, CellS
     const uint32_t lo = uint32_t(local[a]) * q;
     for (int dv = 0; dv <= 1; ++dv) {
       const int ray0 = (local[av] + dv) * c + local[au];
-      const uint32_t n0 = family.point_count(ray0), n1 = family.point_count(ray0 + 1);
-      if (!n0 && !n1) continue;
-      const uint32_t first = family.first_point(ray0);
+      if (!family.holds_points(ray0) && !family.holds_points(ray0 + 1)) continue;
+      uint32_t n[2];
+      const uint32_t first = family.first_point(ray0, n);
+      const uint32_t n0 = n[0], n1 = n[1];
       glm::dvec3 node(0.0);
       node[av] = dv;
       if (n0) add_edge_points(family, first, n0, lo, lo + q, node, a, out);

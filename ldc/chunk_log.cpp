@@ -259,9 +259,8 @@ std::string stored_chunk_problem(const StoredChunk& s, int c) {
   if (s.kind > ChunkKind::kMixed) return "bad kind";
   if (!s.data) return "";
   if (s.data->is_uniform(nullptr)) return "a mixed chunk holds a uniform one";
-  const size_t words = (size_t(c) * size_t(c) + 63) / 64;
   for (const RayFamily& f : s.data->axis) {
-    if (!f.is_uniform() && f.inside_bits().size() != words) return "data of another chunk size";
+    if (!f.is_uniform() && f.size() != c) return "data of another chunk size";
   }
   return "";
 }

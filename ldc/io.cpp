@@ -116,8 +116,9 @@ void write_family(Writer& w, const RayFamily& f, int c) {
     return;
   }
   w.u8(0);
-  for (uint64_t word : f.inside_bits()) w.u64(word);
-  for (int r = 0; r < c * c; ++r) w.u16(uint16_t(f.point_count(r)));
+  for (uint64_t word : f.start_bits()) w.u64(word);
+  RayReader rays(f);
+  for (int r = 0; r < c * c; ++r) w.u16(uint16_t(rays.next().points.size()));
   for (const PackedPoint& p : f.all_points()) {
     w.u16(p.depth);
     w.u16(p.material);

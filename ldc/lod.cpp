@@ -22,8 +22,9 @@ RayFamily coarse_family(const RayFamily& f, int chunk_size, int stride) {
   for (int v = 0; v < coarse; ++v) {
     for (int u = 0; u < coarse; ++u) {
       const int fine_ray = v * stride * chunk_size + u * stride;
-      out.begin_ray(f.starts_inside(fine_ray));
-      for (const PackedPoint& p : f.points(fine_ray)) out.add_point(p);
+      const std::span<const PackedPoint> points = f.points(fine_ray);
+      out.begin_ray(f.starts_inside(fine_ray, points));
+      for (const PackedPoint& p : points) out.add_point(p);
     }
   }
   return out.finish();

@@ -65,7 +65,8 @@ bool check_family_arrays(const RayFamily& f, int c, const glm::ivec3& coord, int
     return false;
   }
   bool any_in = false, any_out = false;
-  for (int r = 0; r < c * c; ++r) (f.starts_inside(r) ? any_in : any_out) = true;
+  RayReader rays(f);
+  for (int r = 0; r < c * c; ++r) (rays.next().starts_inside ? any_in : any_out) = true;
   if (f.all_points().empty() && !(any_in && any_out)) {
     sink.add(where(coord, axis, -1) + ": family holds no points and uniform rays but is not stored as uniform");
   }
@@ -81,7 +82,7 @@ bool check_family_arrays(const RayFamily& f, int c, const glm::ivec3& coord, int
 void check_ray(const RayFamily& f, std::span<const PackedPoint> pts, int axis, int ray, int c,
                const glm::ivec3& coord, ErrorSink& sink) {
   const uint32_t q = depth_steps_per_cell(c);
-  bool expect_enter = !f.starts_inside(ray);
+  bool expect_enter = !f.starts_inside(ray, pts);
   uint32_t prev = 0;
   auto fail = [&](size_t i, const std::string& what) {
     sink.add(where(coord, axis, ray) + " point " + std::to_string(i) + ": " + what);
@@ -109,11 +110,10 @@ void check_ray(const RayFamily& f, std::span<const PackedPoint> pts, int axis, i
 // Node words of one family in the X layout: out[z*64 + y], bit x.
 void family_node_words(const RayFamily& f, int axis, int c, std::vector<uint64_t>& out) {
   std::vector<uint64_t> fam(size_t(c) * c);
-  const PackedPoint* p = f.all_points().data();
+  RayReader rays(f);
   for (int r = 0; r < c * c; ++r) {
-    const uint32_t n = f.point_count(r);
-    fam[r] = detail::node_word(f.starts_inside(r), std::span<const PackedPoint>(p, n), c);
-    p += n;
+    const RayPoints ray = rays.next();
+    fam[r] = detail::node_word(ray.starts_inside, ray.points, c);
   }
   out.assign(size_t(c) * 64, 0);
   detail::convert_layout(axis, c, fam.data(), out.data(), false);
@@ -147,12 +147,8 @@ void check_chunk(const Chunk& chunk, const glm::ivec3& coord, int c, bool cross_
     }
     const RayFamily& f = chunk.axis[a];
     if (f.is_uniform()) continue;
-    const PackedPoint* p = f.all_points().data();
-    for (int r = 0; r < c * c; ++r) {
-      const uint32_t n = f.point_count(r);
-      check_ray(f, std::span<const PackedPoint>(p, n), a, r, c, coord, sink);
-      p += n;
-    }
+    RayReader rays(f);
+    for (int r = 0; r < c * c; ++r) check_ray(f, rays.next().points, a, r, c, coord, sink);
     sink.rays_visited.fetch_add(size_t(c) * size_t(c), std::memory_order_relaxed);
   }
   if (arrays_ok && cross_axis) check_cross_axis(chunk, c, coord, sink);

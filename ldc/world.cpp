@@ -39,62 +39,124 @@ RayFamily RayFamily::uniform(bool inside) {
 
 bool RayFamily::starts_inside(int ray) const {
   if (is_uniform()) return uniform_inside_;
-  return (inside_[static_cast<size_t>(ray) >> 6] >> (ray & 63)) & 1u;
+  if (!inside_.empty()) return (inside_[static_cast<size_t>(ray) >> 6] >> (ray & 63)) & 1u;
+  const uint32_t code = ray_code(ray);
+  if (code < kOnePoint) return code == kEmptyInside;
+  return (points_[first_point(ray)].normal & kPointExitBit) != 0;
 }
 
-// Sum of the eight byte lanes of x (each at most 255).
-static uint32_t byte_sum(uint64_t x) {
-  x = (x & 0x00FF00FF00FF00FFull) + ((x >> 8) & 0x00FF00FF00FF00FFull);
-  x = (x & 0x0000FFFF0000FFFFull) + ((x >> 16) & 0x0000FFFF0000FFFFull);
-  return uint32_t(x & 0xFFFFFFFFu) + uint32_t(x >> 32);
+// Set bits of x, which has bits at even positions only (a code's high or low
+// bits). Arithmetic rather than std::popcount: without -mpopcnt, which the
+// build does not assume, that is a libgcc call, and ray casts run this per
+// cell (13% of landscape ray-cast time when it was).
+static uint32_t count_even_bits(uint64_t x) {
+  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+  return uint32_t((x * 0x0101010101010101ull) >> 56);
+}
+
+// Popcounts over the codes of the rays of `ray`'s row before it (a row is
+// 2C bits: one word at C = 32, a part of one below, two at C = 64).
+RayFamily::RowPrefix RayFamily::row_prefix(int ray) const {
+  constexpr uint64_t kLow = 0x5555555555555555ull;
+  RowPrefix r;
+  size_t bit = size_t(ray / size_) * size_ * 2;
+  const size_t end = size_t(ray) * 2;
+  while (bit < end) {
+    const size_t n = std::min<size_t>(64 - (bit & 63), end - bit);
+    uint64_t x = codes_[bit >> 6] >> (bit & 63);
+    if (n < 64) x &= (uint64_t{1} << n) - 1;
+    const uint64_t high = (x >> 1) & kLow, low = x & kLow;
+    r.single += count_even_bits(high & ~low);
+    r.several += count_even_bits(high & low);
+    bit += n;
+  }
+  return r;
+}
+
+uint32_t RayFamily::several_count(int ray) const {
+  return several_[row_several(size_t(ray / size_)) + row_prefix(ray).several];
 }
 
 uint32_t RayFamily::first_point(int ray) const {
   if (is_uniform()) return 0;
   if (!first_.empty()) return first_[size_t(ray)];
-  const int row = ray / size_;
-  // Sum the counts before the ray in its row, eight bytes at a time.
-  const int n = ray - row * size_;
-  uint32_t begin = row_first_[size_t(row)];
-  if (nibble_counts_) {
-    const uint8_t* p = counts_.data() + size_t(row) * size_ / 2;  // C is even: rows start on a byte
-    const int bytes = n / 2;
-    int i = 0;
-    for (; i + 8 <= bytes; i += 8) {
-      uint64_t w;
-      std::memcpy(&w, p + i, 8);
-      begin += byte_sum((w & 0x0F0F0F0F0F0F0F0Full) + ((w >> 4) & 0x0F0F0F0F0F0F0F0Full));
-    }
-    for (; i < bytes; ++i) begin += (p[i] & 15u) + (p[i] >> 4);
-    if (n & 1) begin += p[bytes] & 15u;
-    return begin;
-  }
-  const uint8_t* p = counts_.data() + size_t(row) * size_;
-  int i = 0;
-  for (; i + 8 <= n; i += 8) {
-    uint64_t w;
-    std::memcpy(&w, p + i, 8);
-    begin += byte_sum(w);
-  }
-  for (; i < n; ++i) begin += p[i];
+  const size_t row = size_t(ray / size_);
+  const RowPrefix before = row_prefix(ray);
+  uint32_t begin = row_first(row) + before.single;
+  const uint8_t* several = several_.data() + row_several(row);
+  for (uint32_t k = 0; k < before.several; ++k) begin += several[k];
   return begin;
 }
 
+uint32_t RayFamily::first_point(int ray, std::span<uint32_t> counts) const {
+  if (is_uniform()) {
+    std::fill(counts.begin(), counts.end(), 0u);
+    return 0;
+  }
+  if (!first_.empty()) {
+    for (size_t k = 0; k < counts.size(); ++k) counts[k] = first_[size_t(ray) + k + 1] - first_[size_t(ray) + k];
+    return first_[size_t(ray)];
+  }
+  const size_t row = size_t(ray / size_);
+  const RowPrefix before = row_prefix(ray);
+  const uint8_t* several = several_.data() + row_several(row);
+  uint32_t begin = row_first(row) + before.single;
+  for (uint32_t k = 0; k < before.several; ++k) begin += *several++;
+  for (size_t k = 0; k < counts.size(); ++k) {
+    const uint32_t code = ray_code(ray + int(k));
+    counts[k] = code < kOnePoint ? 0u : code == kOnePoint ? 1u : *several++;
+  }
+  return begin;
+}
+
+RayPoints RayReader::next() {
+  const RayFamily& f = family_;
+  const int ray = ray_++;
+  if (f.is_uniform()) return {f.uniform_inside_, {}};
+  uint32_t n = 0;
+  if (!f.first_.empty()) {
+    n = f.first_[size_t(ray) + 1] - f.first_[size_t(ray)];
+  } else {
+    const uint32_t code = f.ray_code(ray);
+    n = code < RayFamily::kOnePoint ? 0u : code == RayFamily::kOnePoint ? 1u : f.several_[several_++];
+  }
+  const std::span<const PackedPoint> points(f.points_.data() + first_, n);
+  first_ += n;
+  return {f.starts_inside(ray, points), points};
+}
+
 std::span<const PackedPoint> RayFamily::points(int ray) const {
+  uint32_t count = 0;
+  const uint32_t first = first_point(ray, std::span<uint32_t>(&count, 1));
+  return std::span<const PackedPoint>(points_.data() + first, count);
+}
+
+std::vector<uint64_t> RayFamily::start_bits() const {
   if (is_uniform()) return {};
-  return std::span<const PackedPoint>(points_.data() + first_point(ray), point_count(ray));
+  if (!inside_.empty()) return inside_;
+  const int rays = int(size_) * size_;
+  std::vector<uint64_t> bits((size_t(rays) + 63) / 64, 0);
+  uint32_t first = 0;
+  for (int r = 0; r < rays; ++r) {
+    const uint32_t n = point_count(r);
+    if (starts_inside(r, std::span<const PackedPoint>(points_.data() + first, n))) bits[size_t(r) >> 6] |= uint64_t{1} << (r & 63);
+    first += n;
+  }
+  return bits;
 }
 
 size_t RayFamily::memory_bytes() const {
-  return counts_.capacity() + (row_first_.capacity() + first_.capacity()) * sizeof(uint32_t) +
+  return codes_.capacity() * sizeof(uint64_t) + several_.capacity() +
+         first_.capacity() * sizeof(uint32_t) + rows_.capacity() * sizeof(uint16_t) +
          inside_.capacity() * sizeof(uint64_t) + points_.capacity() * sizeof(PackedPoint);
 }
 
 std::string RayFamily::check_structure() const {
   if (is_uniform()) return {};
   const size_t c = size_, rays = c * c;
-  if (inside_.size() != (rays + 63) / 64) return "start-bit array has the wrong size";
   if (!first_.empty()) {
+    if (inside_.size() != (rays + 63) / 64) return "start-bit array has the wrong size";
     if (first_.size() != rays + 1 || first_[0] != 0 || first_[rays] != points_.size()) {
       return "ray offsets do not cover the point array";
     }
@@ -103,15 +165,30 @@ std::string RayFamily::check_structure() const {
     }
     return {};
   }
-  if (counts_.size() != (nibble_counts_ ? rays / 2 : rays) || row_first_.size() != c + 1) {
+  if (!inside_.empty() && inside_.size() != (rays + 63) / 64) return "start-bit array has the wrong size";
+  if (codes_.size() != (2 * rays + 63) / 64 || rows_.size() != 2 * (c + 1)) {
     return "count arrays have the wrong size";
   }
-  for (size_t row = 0; row < c; ++row) {
-    uint32_t end = row_first_[row];
-    for (size_t r = row * c; r < (row + 1) * c; ++r) end += point_count(int(r));
-    if (row_first_[row + 1] != end) return "row offsets disagree with counts at row " + std::to_string(row);
+  for (uint8_t n : several_) {
+    if (n < 2) return "a ray coded as holding several points holds fewer than two";
   }
-  if (row_first_[0] != 0 || row_first_[c] != points_.size()) return "row offsets do not cover the point array";
+  for (size_t row = 0; row < c; ++row) {
+    uint32_t end = row_first(row);
+    size_t several = row_several(row);
+    for (size_t r = row * c; r < (row + 1) * c; ++r) {
+      const uint32_t code = ray_code(int(r));
+      if (code == kSeveral && several >= several_.size()) return "several-point counts run out at ray " + std::to_string(r);
+      end += code < kOnePoint ? 0u : code == kOnePoint ? 1u : several_[several];
+      several += code == kSeveral;
+      if (!inside_.empty() && code < kOnePoint && bool(code & 1u) != bool((inside_[r >> 6] >> (r & 63)) & 1u)) {
+        return "an empty ray's code and start bit disagree at ray " + std::to_string(r);
+      }
+    }
+    if (row_first(row + 1) != end) return "row offsets disagree with counts at row " + std::to_string(row);
+    if (row_several(row + 1) != several) return "several-point offsets disagree with codes at row " + std::to_string(row);
+  }
+  if (row_first(0) != 0 || row_first(c) != points_.size()) return "row offsets do not cover the point array";
+  if (row_several(0) != 0 || row_several(c) != several_.size()) return "several-point offsets do not cover the counts";
   return {};
 }
 
@@ -133,6 +210,31 @@ void RayFamilyWriter::begin_ray(bool starts_inside) {
   ++rays_;
 }
 
+// The compact form's arrays from the per-ray offsets; keeps the start bits
+// only where a ray's first point disagrees with its start.
+void RayFamilyWriter::fill_compact(RayFamily& f) {
+  const size_t c = size_t(chunk_size_), rays = c * c;
+  f.codes_.assign((2 * rays + 63) / 64, 0);
+  f.rows_.resize(2 * (c + 1));
+  bool starts_agree = true;
+  for (size_t r = 0; r < rays; ++r) {
+    if (r % c == 0) f.rows_[2 * (r / c)] = uint16_t(first_[r]), f.rows_[2 * (r / c) + 1] = uint16_t(f.several_.size());
+    const uint32_t n = first_[r + 1] - first_[r];
+    const bool inside = (inside_[r >> 6] >> (r & 63)) & 1u;
+    uint64_t code = inside ? RayFamily::kEmptyInside : RayFamily::kEmptyOutside;
+    if (n > 0) {
+      code = n == 1 ? RayFamily::kOnePoint : RayFamily::kSeveral;
+      if (n > 1) f.several_.push_back(uint8_t(n));
+      starts_agree = starts_agree && inside == ((points_[first_[r]].normal & kPointExitBit) != 0);
+    }
+    f.codes_[r >> 5] |= code << ((r & 31) * 2);
+  }
+  f.rows_[2 * c] = uint16_t(first_[rays]);
+  f.rows_[2 * c + 1] = uint16_t(f.several_.size());
+  f.several_.shrink_to_fit();
+  if (!starts_agree) f.inside_ = std::move(inside_);
+}
+
 RayFamily RayFamilyWriter::finish() {
   const int c = chunk_size_;
   assert(rays_ == c * c);
@@ -142,21 +244,12 @@ RayFamily RayFamilyWriter::finish() {
   first_.push_back(static_cast<uint32_t>(points_.size()));
   uint32_t most = 0;
   for (int r = 0; r < c * c; ++r) most = std::max(most, first_[r + 1] - first_[r]);
-  if (most <= 255) {
-    const size_t rays = static_cast<size_t>(c) * c;
-    f.nibble_counts_ = most <= 15;
-    f.counts_.assign(f.nibble_counts_ ? rays / 2 : rays, 0);
-    for (size_t r = 0; r < rays; ++r) {
-      const uint32_t n = first_[r + 1] - first_[r];
-      if (f.nibble_counts_) f.counts_[r >> 1] |= static_cast<uint8_t>(n << ((r & 1) << 2));
-      else f.counts_[r] = static_cast<uint8_t>(n);
-    }
-    f.row_first_.resize(static_cast<size_t>(c) + 1);
-    for (int row = 0; row <= c; ++row) f.row_first_[row] = first_[static_cast<size_t>(row) * c];
+  if (most <= 255 && points_.size() <= 65535) {  // the compact form's offsets are 16-bit
+    fill_compact(f);
   } else {
     f.first_ = std::move(first_);
+    f.inside_ = std::move(inside_);
   }
-  f.inside_ = std::move(inside_);
   points_.shrink_to_fit();
   f.points_ = std::move(points_);
   return f;
@@ -461,15 +554,13 @@ std::vector<Span> World::ray_spans(int axis, const glm::ivec2& uv) const {
 
 namespace {
 
-// Inside length (cells) of one ray segment of a chunk.
-// `points` are the ray's: callers walk rays in order, slicing all_points()
-// by point_count() (RayFamily::points sums a row's counts: O(C) per ray).
-double segment_inside_length(const RayFamily& f, std::span<const PackedPoint> points, int ray,
-                             int chunk_size) {
+// Inside length (cells) of one ray segment of a chunk (callers walk the
+// rays in order with a RayReader: random access sums a row's offsets).
+double segment_inside_length(const RayPoints& ray, int chunk_size) {
   const double steps = depth_steps_per_cell(chunk_size);
-  bool in = f.starts_inside(ray);
+  bool in = ray.starts_inside;
   double last = 0.0, sum = 0.0;
-  for (const PackedPoint& p : points) {
+  for (const PackedPoint& p : ray.points) {
     double d = p.depth / steps;
     if (in) sum += d - last;
     last = d;
@@ -489,12 +580,8 @@ double World::volume(int axis) const {
     if (kinds_[slot] == ChunkKind::kSolid) cells += double(c) * c * c;
     if (kinds_[slot] != ChunkKind::kMixed) continue;
     const RayFamily& f = chunks_[slot]->axis[axis];
-    const PackedPoint* p = f.all_points().data();
-    for (int r = 0; r < c * c; ++r) {
-      const uint32_t n = f.point_count(r);
-      cells += segment_inside_length(f, std::span<const PackedPoint>(p, n), r, c);
-      p += n;
-    }
+    RayReader rays(f);
+    for (int r = 0; r < c * c; ++r) cells += segment_inside_length(rays.next(), c);
   }
   return cells * h * h * h;
 }
@@ -511,12 +598,9 @@ std::optional<WorldBox> World::solid_bounds() const {
     if (!data) return;
     for (int a = 0; a < 3; ++a) {
       const RayFamily& f = data->axis[a];
-      const PackedPoint* first = f.all_points().data();
+      RayReader rays(f);
       for (int r = 0; r < c * c; ++r) {
-        const uint32_t n = f.point_count(r);
-        const std::span<const PackedPoint> points(first, n);
-        first += n;
-        for (const PackedPoint& p : points) {
+        for (const PackedPoint& p : rays.next().points) {
           glm::dvec3 q = detail::point_lattice_position(ch, a, r, p.depth, c);
           lo = glm::min(lo, q);
           hi = glm::max(hi, q);

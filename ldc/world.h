@@ -124,11 +124,14 @@ struct Span {
 
 // All rays of one axis inside one chunk: C*C rays, ray index = v_local*C + u_local.
 // Frozen structure of arrays: the points of all rays in one array, ray after
-// ray, located by a point count per ray and the first point of each row of C
-// rays. Counts take four bits a ray where no ray holds more than 15 points
-// (nearly always: about 0.6 byte per ray with the row offsets), else a byte.
-// A family with a ray of more than 255 points keeps a 32-bit offset per ray
-// instead.
+// ray, located by a two-bit code per ray (empty and outside at its start,
+// empty and inside, one point, several: their count in a byte beside) and
+// the first point of each row of C rays: about 0.38 byte per ray. A ray's
+// start (inside or not) is its first point's sense, or the code of an empty
+// ray; a family whose start bits disagree with its points (invalid, but
+// kept for validate() to report) keeps a start bit per ray as well. A family
+// with a ray of more than 255 points, or of more than 65535 points in all,
+// keeps a 32-bit offset and a start bit per ray instead.
 class RayFamily {
  public:
   // A family whose rays hold no points and are all outside / all inside.
@@ -136,39 +139,89 @@ class RayFamily {
   RayFamily() = default;  // uniform outside
 
   bool is_uniform() const { return size_ == 0; }
+  int size() const { return size_; }  // C, or 0 when uniform
   bool uniform_inside() const { return uniform_inside_; }
   bool starts_inside(int ray) const;
+  // The same, given the ray's points (as points(ray) or a walk along a row
+  // gives them): saves the offset sum.
+  bool starts_inside(int ray, std::span<const PackedPoint> ray_points) const {
+    if (is_uniform()) return uniform_inside_;
+    if (!inside_.empty()) return (inside_[size_t(ray) >> 6] >> (ray & 63)) & 1u;
+    if (ray_points.empty()) return ray_code(ray) & 1u;
+    return (ray_points.front().normal & kPointExitBit) != 0;
+  }
   std::span<const PackedPoint> points(int ray) const;
   // Index in all_points() of the ray's first point (sums the counts of the
   // rays before it in its row). Walks along a row can instead add up
   // point_count() themselves.
   uint32_t first_point(int ray) const;
+  // The same, with the point counts of `counts.size()` rays from `ray` on in
+  // its row, in one pass (cell walks read two neighbouring rays).
+  uint32_t first_point(int ray, std::span<uint32_t> counts) const;
+  bool holds_points(int ray) const {
+    if (is_uniform()) return false;
+    if (!first_.empty()) return first_[size_t(ray) + 1] != first_[size_t(ray)];
+    return ray_code(ray) >= kOnePoint;
+  }
   // Points on one ray, in constant time (no offset sums): lets walks skip empty rays.
   uint32_t point_count(int ray) const {
     if (is_uniform()) return 0;
     if (!first_.empty()) return first_[size_t(ray) + 1] - first_[size_t(ray)];
-    if (!nibble_counts_) return counts_[size_t(ray)];
-    return (counts_[size_t(ray) >> 1] >> ((ray & 1) << 2)) & 15u;
+    const uint32_t code = ray_code(ray);
+    return code < kOnePoint ? 0u : code == kOnePoint ? 1u : several_count(ray);
   }
   size_t point_count() const { return points_.size(); }
   size_t memory_bytes() const;
 
   // Raw arrays, for file I/O and validate(); empty when uniform.
-  std::span<const uint64_t> inside_bits() const { return inside_; }
+  std::vector<uint64_t> start_bits() const;  // bit r: starts_inside(r)
   std::span<const PackedPoint> all_points() const { return points_; }
   // Checks the offset arrays against each other; returns "" or what is wrong.
   std::string check_structure() const;
 
  private:
   friend class RayFamilyWriter;
+  friend class RayReader;
+  // Ray codes: empty rays by their start, then one point, then several.
+  static constexpr uint32_t kEmptyOutside = 0, kEmptyInside = 1, kOnePoint = 2, kSeveral = 3;
+  struct RowPrefix {
+    uint32_t single = 0, several = 0;  // rays before the ray in its row with one point, with several
+  };
+  uint32_t ray_code(int ray) const { return uint32_t(codes_[size_t(ray) >> 5] >> ((ray & 31) * 2)) & 3u; }
+  RowPrefix row_prefix(int ray) const;
+  uint32_t several_count(int ray) const;
+  uint32_t row_first(size_t row) const { return rows_[2 * row]; }
+  uint32_t row_several(size_t row) const { return rows_[2 * row + 1]; }
+
   uint8_t size_ = 0;  // C, or 0 when uniform
   bool uniform_inside_ = false;
-  bool nibble_counts_ = false;       // counts_ holds two rays a byte (even ray low)
-  std::vector<uint8_t> counts_;      // points per ray (compact form)
-  std::vector<uint32_t> row_first_;  // first point of each row, C + 1 entries (compact form)
-  std::vector<uint32_t> first_;      // first point of each ray, C*C + 1 entries (wide form)
-  std::vector<uint64_t> inside_;     // start-inside bit per ray
+  std::vector<uint64_t> codes_;         // two bits a ray, ray r at bit 2 (r mod 32) of word r / 32 (compact form)
+  std::vector<uint8_t> several_;        // point counts of the rays coded kSeveral, in ray order
+  std::vector<uint16_t> rows_;          // per row r <= C: first point, first entry of several_ (compact form)
+  std::vector<uint32_t> first_;         // first point of each ray, C*C + 1 entries (wide form)
+  std::vector<uint64_t> inside_;        // start bit per ray: wide form, or starts that disagree with the points
   std::vector<PackedPoint> points_;
+};
+
+// One ray of a family: its start and its points.
+struct RayPoints {
+  bool starts_inside = false;
+  std::span<const PackedPoint> points;
+};
+
+// Reads a family's rays in order 0 .. C*C-1, each in constant time (random
+// access through RayFamily sums offsets along the ray's row). Keeps a
+// reference: the family must outlive it.
+class RayReader {
+ public:
+  explicit RayReader(const RayFamily& family) : family_(family) {}
+  RayPoints next();
+
+ private:
+  const RayFamily& family_;
+  int ray_ = 0;
+  uint32_t first_ = 0;    // first point of the next ray
+  uint32_t several_ = 0;  // next entry of the several-point counts
 };
 
 // Builds a RayFamily ray by ray, in ray order 0 .. C*C-1.
@@ -181,6 +234,8 @@ class RayFamilyWriter {
   RayFamily finish();
 
  private:
+  void fill_compact(RayFamily& f);
+
   int chunk_size_;
   int rays_ = 0;
   bool any_inside_ = false;

@@ -83,7 +83,7 @@ std::string temp_folder() {
 
 bool same_family(const RayFamily& a, const RayFamily& b, int c) {
   if (a.is_uniform() != b.is_uniform() || a.uniform_inside() != b.uniform_inside()) return false;
-  if (!std::equal(a.inside_bits().begin(), a.inside_bits().end(), b.inside_bits().begin(), b.inside_bits().end())) {
+  if (a.start_bits() != b.start_bits()) {
     return false;
   }
   for (int r = 0; r < c * c; ++r) {

@@ -1,5 +1,7 @@
-// RayFamily's storage: four-bit counts while no ray holds more than 15
-// points, byte counts past that, and the wide form (32-bit offsets) past 255.
+// RayFamily's storage: a two-bit code per ray (empty outside, empty inside,
+// one point, several with a byte count beside), start bits only where they
+// disagree with the points, and the wide form (32-bit offsets) past 255
+// points on a ray.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -85,15 +87,14 @@ TEST(RayFamily, FullAndSingleRayFamiliesReadBack) {
   }
 }
 
-TEST(RayFamily, ARayOfMoreThan15PointsSwitchesToByteCounts) {
-  const int c = 32;
-  std::vector<Ray> rays = random_rays(c, 0.5, 15, 13);
-  expect_reads_back(write(c, rays), rays);
-  const size_t nibbles = write(c, rays).memory_bytes();
-  rays[77].points.clear();
-  for (int i = 0; i < 16; ++i) rays[77].points.push_back(point_at(uint16_t(i + 1), i % 2 == 1));
-  expect_reads_back(write(c, rays), rays);
-  EXPECT_GT(write(c, rays).memory_bytes(), nibbles + size_t(c) * c / 2 - 8);  // a byte per ray again
+TEST(RayFamily, RaysOfUpTo255PointsReadBackThroughTheirByteCounts) {
+  for (int c : {8, 16, 32, 64}) {
+    SCOPED_TRACE(c);
+    std::vector<Ray> rays = random_rays(c, 0.5, 15, 13);
+    rays[size_t(c) + 3].points.clear();
+    for (int i = 0; i < 255; ++i) rays[size_t(c) + 3].points.push_back(point_at(uint16_t(i + 1), i % 2 == 1));
+    expect_reads_back(write(c, rays), rays);
+  }
 }
 
 TEST(RayFamily, ARayOfMoreThan255PointsSwitchesToTheWideForm) {
@@ -104,15 +105,57 @@ TEST(RayFamily, ARayOfMoreThan255PointsSwitchesToTheWideForm) {
   expect_reads_back(write(c, rays), rays);
 }
 
-TEST(RayFamily, CountsTakeHalfAByteARay) {
+TEST(RayFamily, MoreThan65535PointsInAllSwitchToTheWideForm) {
+  const int c = 64;
+  std::vector<Ray> rays(size_t(c) * c);
+  for (Ray& r : rays)
+    for (int i = 0; i < 16; ++i) r.points.push_back(point_at(uint16_t(i + 1), i % 2 == 1));  // 65536 in all
+  const RayFamily f = write(c, rays);
+  expect_reads_back(f, rays);
+  EXPECT_GE(f.memory_bytes(), 65536 * sizeof(PackedPoint) + (size_t(c) * c + 1) * sizeof(uint32_t));  // a 32-bit offset a ray
+}
+
+// Rays whose first point's sense says how they start: the start bits are
+// dropped (an empty ray's code holds its start).
+std::vector<Ray> consistent(std::vector<Ray> rays) {
+  for (Ray& r : rays)
+    if (!r.points.empty()) r.inside = (r.points.front().normal & kPointExitBit) != 0;
+  return rays;
+}
+
+TEST(RayFamily, CodesTakeAQuarterByteARayWhereStartsAgreeWithThePoints) {
   const int c = 32;
-  const std::vector<Ray> rays = random_rays(c, 0.7, 4, 3);
-  size_t points = 0;
-  for (const Ray& r : rays) points += r.points.size();
+  const std::vector<Ray> rays = consistent(random_rays(c, 0.7, 4, 3));
+  size_t points = 0, several = 0;
+  for (const Ray& r : rays) points += r.points.size(), several += r.points.size() > 1;
   const size_t ray_count = size_t(c) * c;
-  // Four-bit counts, row offsets, start bits, points.
-  const size_t expected = ray_count / 2 + (size_t(c) + 1) * 4 + ray_count / 8 + points * 8;
-  EXPECT_EQ(write(c, rays).memory_bytes(), expected);
+  // Two-bit codes, a byte per ray of several points, row offsets (points and
+  // several-point counts), points.
+  const size_t expected = ray_count / 4 + several + (size_t(c) + 1) * (2 + 2) + points * 8;
+  const RayFamily f = write(c, rays);
+  expect_reads_back(f, rays);
+  EXPECT_EQ(f.memory_bytes(), expected);
+}
+
+TEST(RayFamily, StartsThatDisagreeWithThePointsKeepTheirBits) {
+  const int c = 16;
+  std::vector<Ray> rays = consistent(random_rays(c, 0.5, 3, 5));
+  const size_t agreeing = write(c, rays).memory_bytes();
+  size_t ray = 0;
+  while (rays[ray].points.empty()) ++ray;
+  rays[ray].inside = !rays[ray].inside;  // invalid data, kept as written for validate() to report
+  const RayFamily f = write(c, rays);
+  expect_reads_back(f, rays);
+  EXPECT_EQ(f.memory_bytes(), agreeing + size_t(c) * c / 8);
+  EXPECT_EQ(f.start_bits()[ray >> 6] >> (ray & 63) & 1u, uint64_t(rays[ray].inside));
+}
+
+TEST(RayFamily, StartBitsListEveryRaysStart) {
+  const int c = 8;
+  const std::vector<Ray> rays = consistent(random_rays(c, 0.5, 3, 9));
+  const std::vector<uint64_t> bits = write(c, rays).start_bits();
+  ASSERT_EQ(bits.size(), 1u);
+  for (size_t r = 0; r < rays.size(); ++r) EXPECT_EQ((bits[0] >> r) & 1u, uint64_t(rays[r].inside)) << "ray " << r;
 }
 
 }  // namespace

@@ -253,8 +253,8 @@ class AxisPass {
       bool state = column_[i].kind == ChunkKind::kSolid;
       std::span<const PackedPoint> pts;
       if (fam) {
-        state = fam->is_uniform() ? fam->uniform_inside() : fam->starts_inside(ray);
         if (!fam->is_uniform()) pts = fam->points(ray);
+        state = fam->starts_inside(ray, pts);
       }
       size_t k = 0;
       for (; k < pts.size() && seg + pts[k].depth < lo; ++k) state = pts[k].enters();
