@@ -45,20 +45,9 @@ bool RayFamily::starts_inside(int ray) const {
   return (points_[first_point(ray)].normal & kPointExitBit) != 0;
 }
 
-// Set bits of x, which has bits at even positions only (a code's high or low
-// bits). Arithmetic rather than std::popcount: without -mpopcnt, which the
-// build does not assume, that is a libgcc call, and ray casts run this per
-// cell (13% of landscape ray-cast time when it was).
-static uint32_t count_even_bits(uint64_t x) {
-  x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
-  x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
-  return uint32_t((x * 0x0101010101010101ull) >> 56);
-}
-
-// Popcounts over the codes of the rays of `ray`'s row before it (a row is
-// 2C bits: one word at C = 32, a part of one below, two at C = 64).
-RayFamily::RowPrefix RayFamily::row_prefix(int ray) const {
-  constexpr uint64_t kLow = 0x5555555555555555ull;
+// Popcounts over the codes of the rays of `ray`'s row before it when the
+// row spans two words (C = 64; smaller rows take row_prefix's one-word path).
+RayFamily::RowPrefix RayFamily::wide_row_prefix(int ray) const {
   RowPrefix r;
   size_t bit = size_t(ray / size_) * size_ * 2;
   const size_t end = size_t(ray) * 2;
@@ -66,9 +55,8 @@ RayFamily::RowPrefix RayFamily::row_prefix(int ray) const {
     const size_t n = std::min<size_t>(64 - (bit & 63), end - bit);
     uint64_t x = codes_[bit >> 6] >> (bit & 63);
     if (n < 64) x &= (uint64_t{1} << n) - 1;
-    const uint64_t high = (x >> 1) & kLow, low = x & kLow;
-    r.single += count_even_bits(high & ~low);
-    r.several += count_even_bits(high & low);
+    const RowPrefix part = code_counts(x);
+    r.single += part.single, r.several += part.several;
     bit += n;
   }
   return r;
