@@ -66,16 +66,7 @@ uint32_t RayFamily::several_count(int ray) const {
   return several_[row_several(size_t(ray / size_)) + row_prefix(ray).several];
 }
 
-uint32_t RayFamily::first_point(int ray) const {
-  if (is_uniform()) return 0;
-  if (!first_.empty()) return first_[size_t(ray)];
-  const size_t row = size_t(ray / size_);
-  const RowPrefix before = row_prefix(ray);
-  uint32_t begin = row_first(row) + before.single;
-  const uint8_t* several = several_.data() + row_several(row);
-  for (uint32_t k = 0; k < before.several; ++k) begin += several[k];
-  return begin;
-}
+uint32_t RayFamily::first_point(int ray) const { return first_point(ray, {}); }
 
 uint32_t RayFamily::first_point(int ray, std::span<uint32_t> counts) const {
   if (is_uniform()) {
