@@ -75,20 +75,18 @@ void Region::load_tile(int axis, int tu, int tv) {
       for (; at < ray; ++at)  // rays between every stride-th one (none at stride 1)
         for (int k = 0; k < span; ++k)
           if (fam[k]) offset[k] += fam[k]->point_count(at);
-      bool state = fam[0] ? fam[0]->starts_inside(ray, std::span<const PackedPoint>(fam[0]->all_points().data() + offset[0],
-                                                                                   fam[0]->point_count(ray)))
-                          : uniform_inside[0];
+      bool state = uniform_inside[0];
       pts.clear();
       for (int k = 0; k < span; ++k) {
         if (!fam[k]) continue;
-        uint32_t n = fam[k]->point_count(ray);
-        const PackedPoint* p = fam[k]->all_points().data() + offset[k];
-        offset[k] += n;
+        const std::span<const PackedPoint> ray_points(fam[k]->all_points().data() + offset[k], fam[k]->point_count(ray));
+        offset[k] += uint32_t(ray_points.size());
+        if (k == 0) state = fam[0]->starts_inside(ray, ray_points);
         const int64_t base = int64_t(k + k0) * kDepthSteps;
-        for (uint32_t i = 0; i < n; ++i) {
-          int64_t d = base + p[i].depth;
+        for (const PackedPoint& p : ray_points) {
+          int64_t d = base + p.depth;
           if (d < lo) state = !state;
-          else if (d < hi) pts.push_back({double(d) / double(q), &p[i]});
+          else if (d < hi) pts.push_back({double(d) / double(q), &p});
         }
       }
       at = ray + 1;

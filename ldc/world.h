@@ -152,8 +152,8 @@ class RayFamily {
   }
   std::span<const PackedPoint> points(int ray) const;
   // Index in all_points() of the ray's first point (sums the counts of the
-  // rays before it in its row). Walks along a row can instead add up
-  // point_count() themselves.
+  // rays before it in its row). Walks over a family's rays in order use a
+  // RayReader instead.
   uint32_t first_point(int ray) const;
   // The same, with the point counts of `counts.size()` rays from `ray` on in
   // its row, in one pass (cell walks read two neighbouring rays).
@@ -163,7 +163,8 @@ class RayFamily {
     if (!first_.empty()) return first_[size_t(ray) + 1] != first_[size_t(ray)];
     return ray_code(ray) >= kOnePoint;
   }
-  // Points on one ray, in constant time (no offset sums): lets walks skip empty rays.
+  // Points on one ray, in constant time (its code; a ray of several points
+  // also counts the codes before it in its row): lets walks skip empty rays.
   uint32_t point_count(int ray) const {
     if (is_uniform()) return 0;
     if (!first_.empty()) return first_[size_t(ray) + 1] - first_[size_t(ray)];

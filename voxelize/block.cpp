@@ -253,7 +253,7 @@ class AxisPass {
       bool state = column_[i].kind == ChunkKind::kSolid;
       std::span<const PackedPoint> pts;
       if (fam) {
-        if (!fam->is_uniform()) pts = fam->points(ray);
+        pts = fam->points(ray);  // empty for a uniform family
         state = fam->starts_inside(ray, pts);
       }
       size_t k = 0;

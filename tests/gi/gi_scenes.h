@@ -85,7 +85,6 @@ inline std::vector<GiBox> closed_room(uint16_t wall_material = 0, double outer =
           {{-b, -b, -b}, {b, -a, b}, wall_material}, {{-b, a, -b}, {b, b, b}, wall_material}};
 }
 
-
 // The CPU engine's irradiance at five points on the inside walls of a
 // glowing closed room (closed_room(2, ...): emission 4, albedo 0.7) over
 // the exact furnace value 4 pi (1 + 0.7 + 0.49 ...), after 1, 2 and 3
