@@ -2,6 +2,7 @@
 // the six-face G-buffer, the packed formats, cascades (scrolling, edits), static
 // objects and the errors of bad input.
 #include <gtest/gtest.h>
+#include <tbb/task_arena.h>
 
 #include <signal.h>
 #include <sys/resource.h>
@@ -335,6 +336,26 @@ TEST(Cascades, ScrollingByAnyShiftEqualsVoxelizingAfresh) {
     ASSERT_TRUE(fresh.update_all(w, cam).ok());
     ASSERT_TRUE(same_cascades(moving.value(), fresh)) << "after shift " << d.x << "," << d.y << "," << d.z;
   }
+}
+
+// A whole level is cut into smaller blocks when few blocks hold chunks and
+// there are more workers to feed: the result may not depend on the cut.
+TEST(Cascades, FullUpdateOnOneThreadEqualsOneOnEight) {
+  World w = small_terrain();
+  CascadeConfig config = small_cascade();
+  config.levels = 4;
+  config.resolution = 16;
+  auto update_on = [&](int threads) {
+    Cascades c = Cascades::create(w.lattice(), config).value();
+    EXPECT_TRUE(c.add_object(crate()).ok());
+    tbb::task_arena arena(threads);
+    arena.execute([&] { EXPECT_TRUE(c.update_all(w, {5.0, 5.0, 6.0}).ok()); });
+    return c;
+  };
+  // The cuts differ: levels 0 and 1 take blocks of 16^3 on one thread and
+  // 8^3 on eight, level 2 8^3 and 4^3.
+  const Cascades one = update_on(1), eight = update_on(8);
+  EXPECT_TRUE(same_cascades(one, eight));
 }
 
 TEST(Cascades, ScrollVoxelizesOnlyTheExposedSlab) {
