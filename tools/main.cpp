@@ -74,8 +74,10 @@ int main(int argc, char** argv) {
   ldc::tool::add_voxelize_command(app, common);
   ldc::tool::add_bake_command(app, common);
   for (CLI::App* command : app.get_subcommands({})) {  // after a command's own footer, if any
+    // (a command without one has inherited the app's, which is this already)
     const std::string own = command->get_footer();
-    command->footer(own.empty() ? ldc::tool::kExitStatusHelp : own + "\n" + ldc::tool::kExitStatusHelp);
+    const bool inherited = own.empty() || own == ldc::tool::kExitStatusHelp;
+    command->footer(inherited ? ldc::tool::kExitStatusHelp : own + "\n" + ldc::tool::kExitStatusHelp);
     // Runs once the command line is parsed, before the command: no output over an input.
     command->parse_complete_callback([command] {
       const std::string clash = ldc::tool::output_clash(*command);
