@@ -582,18 +582,42 @@ class ChunkMesher {
   bool is_plain(const Cell& cell) const {
     const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
     if (chunk == chunk_ && !finer_neighbour_) return true;
-    // The chunks whose closed boxes the cell's closed box touches: its own,
-    // and across each chunk face, edge or corner it lies on.
+    return finest_touching_level(cell) >= cell.level;
+  }
+
+  // The finest level among the chunks whose closed boxes the cell's closed
+  // box touches: its own, and across each chunk face, edge or corner it lies
+  // on. Every node the pieces' way reads lies on the cell's boundary at a
+  // multiple of 2^that level.
+  int finest_touching_level(const Cell& cell) const {
+    const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
     const glm::ivec3 r = cell.lo - chunk * chunk_size_;
     glm::ivec3 lo(0), hi(0);
     for (int k = 0; k < 3; ++k) {
       lo[k] = r[k] == 0 ? -1 : 0;
       hi[k] = r[k] + cell.size() == chunk_size_ ? 1 : 0;
     }
+    int level = levels_->at(chunk);
     for (int dz = lo.z; dz <= hi.z; ++dz)
       for (int dy = lo.y; dy <= hi.y; ++dy)
-        for (int dx = lo.x; dx <= hi.x; ++dx)
-          if (levels_->at(chunk + glm::ivec3(dx, dy, dz)) < cell.level) return false;
+        for (int dx = lo.x; dx <= hi.x; ++dx) level = std::min(level, levels_->at(chunk + glm::ivec3(dx, dy, dz)));
+    return level;
+  }
+
+  // Whether every node on the cell's boundary at that finest spacing is on
+  // one side: then no edge the pieces' way would read changes sign and the
+  // cell has no crossing. Most cells beside a finer chunk are such (the
+  // whole layer is a candidate; on a bunny-and-sphere union at 256 cells 95%
+  // of them were empty), and this reads their nodes without building pieces.
+  bool boundary_on_one_side(const Cell& cell) {
+    const int s = cell.size(), step = std::min(s, 1 << finest_touching_level(cell));
+    const bool first = reader_.inside(cell.lo);
+    for (int z = 0; z <= s; z += step)
+      for (int y = 0; y <= s; y += step) {
+        const bool face = z == 0 || z == s || y == 0 || y == s;
+        for (int x = 0; x <= s; x += face ? step : s)  // inside the cube: only x = 0 and x = s
+          if (reader_.inside(cell.lo + glm::ivec3(x, y, z)) != first) return false;
+      }
     return true;
   }
 
@@ -610,6 +634,8 @@ class ChunkMesher {
     const bool plain = is_plain(cell);
     if (plain) {
       if (const int found = plain_sheets(cell, shape); found >= 0) return found == 1;
+    } else if (boundary_on_one_side(cell)) {
+      return false;
     }
     build_pieces(*levels_, chunk_size_, cell, plain, shape);
     if (!read_crossings(reader_, shape)) return false;
