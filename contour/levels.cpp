@@ -577,20 +577,15 @@ class ChunkMesher {
     return cells;
   }
 
-  // Whether no chunk finer than the cell touches it: true inside a chunk
-  // whose neighbours are no finer, and away from the chunk's faces.
-  bool is_plain(const Cell& cell) const {
-    const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
-    if (chunk == chunk_ && !finer_neighbour_) return true;
-    return finest_touching_level(cell) >= cell.level;
-  }
-
   // The finest level among the chunks whose closed boxes the cell's closed
   // box touches: its own, and across each chunk face, edge or corner it lies
-  // on. Every node the pieces' way reads lies on the cell's boundary at a
-  // multiple of 2^that level.
+  // on (the cell's own level inside a chunk whose neighbours are no finer).
+  // The cell is plain when no touching chunk is finer than it; otherwise
+  // every node the pieces' way reads lies on its boundary at a multiple of
+  // 2^that level.
   int finest_touching_level(const Cell& cell) const {
     const glm::ivec3 chunk = cell.lo >> levels_->chunk_shift();
+    if (chunk == chunk_ && !finer_neighbour_) return cell.level;
     const glm::ivec3 r = cell.lo - chunk * chunk_size_;
     glm::ivec3 lo(0), hi(0);
     for (int k = 0; k < 3; ++k) {
@@ -609,8 +604,8 @@ class ChunkMesher {
   // cell has no crossing. Most cells beside a finer chunk are such (the
   // whole layer is a candidate; on a bunny-and-sphere union at 256 cells 95%
   // of them were empty), and this reads their nodes without building pieces.
-  bool boundary_on_one_side(const Cell& cell) {
-    const int s = cell.size(), step = std::min(s, 1 << finest_touching_level(cell));
+  bool boundary_on_one_side(const Cell& cell, int finest) {
+    const int s = cell.size(), step = 1 << finest;
     const bool first = reader_.inside(cell.lo);
     for (int z = 0; z <= s; z += step)
       for (int y = 0; y <= s; y += step) {
@@ -631,10 +626,11 @@ class ChunkMesher {
 
   // The cell's sheets under the default rule; false when it has no crossing.
   bool default_sheets(const Cell& cell, CellShape& shape) {
-    const bool plain = is_plain(cell);
+    const int finest = finest_touching_level(cell);
+    const bool plain = finest >= cell.level;
     if (plain) {
       if (const int found = plain_sheets(cell, shape); found >= 0) return found == 1;
-    } else if (boundary_on_one_side(cell)) {
+    } else if (boundary_on_one_side(cell, finest)) {
       return false;
     }
     build_pieces(*levels_, chunk_size_, cell, plain, shape);

@@ -5,7 +5,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
-#include <limits>
 #include <sstream>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -22,12 +21,12 @@ namespace ldc {
 namespace {
 
 // Blocks of a level's update: 16^3 voxels, halved (down to 4^3) while
-// fewer than kBusyBlocksPerWorker blocks per worker hold any chunk. A coarse
-// level's 32^3 box is mostly air around a landscape that fits in one or two
-// 16^3 blocks, which left the second core idle (level 4 of the default
-// landscape: 13.1 ms on 1 thread, 12.3 ms on 2). Smaller blocks cost more
-// per voxel (each ray is entered once per block), so levels whose work is
-// already spread keep 16.
+// fewer than kBusyBlocksPerWorker blocks per worker overlap the world's box
+// of chunks. A coarse level's 32^3 box is mostly air around a landscape that
+// fits in one or two 16^3 blocks, which left the second core idle (level 4
+// of the default landscape: 13.1 ms on 1 thread, 12.3 ms on 2). Smaller
+// blocks cost more per voxel (each ray is entered once per block), so
+// levels whose work is already spread keep 16.
 constexpr int kBlockEdge = 16;
 constexpr int kSmallestBlockEdge = 4;
 constexpr int kBusyBlocksPerWorker = 2;
@@ -52,24 +51,16 @@ glm::ivec3 face_direction(int f) {
 
 VoxelBox grow(const VoxelBox& b, int r) { return {b.lo - r, b.dims + 2 * r}; }
 
-// The voxels, of m lattice cells each, that the world's stored chunks (solid
-// or holding points) overlap: everything else is air. One pass over the
-// chunk table, not over points.
+// The voxels, of m lattice cells each, of the world's box of chunks: outside
+// it everything is air.
 VoxelBox chunk_voxel_box(const World& world, int m) {
-  const int64_t c = world.config().chunk_size;
-  glm::i64vec3 lo(std::numeric_limits<int64_t>::max()), hi(std::numeric_limits<int64_t>::min());
-  world.for_each_chunk([&](const glm::ivec3& ch, ChunkKind kind, const Chunk*) {
-    if (kind == ChunkKind::kEmpty) return;
-    lo = glm::min(lo, glm::i64vec3(ch) * c);
-    hi = glm::max(hi, (glm::i64vec3(ch) + int64_t(1)) * c - int64_t(1));
-  });
-  if (lo.x > hi.x) return {};
-  glm::ivec3 vlo, vhi;
+  const int64_t c = world.chunk_size();
+  glm::ivec3 lo, hi;
   for (int a = 0; a < 3; ++a) {
-    vlo[a] = int(std::clamp<int64_t>(detail::floor_div64(lo[a], m), INT32_MIN / 2, INT32_MAX / 2));
-    vhi[a] = int(std::clamp<int64_t>(detail::floor_div64(hi[a], m), INT32_MIN / 2, INT32_MAX / 2));
+    lo[a] = int(detail::floor_div64(int64_t(world.chunk_origin()[a]) * c, m));
+    hi[a] = int(detail::floor_div64((int64_t(world.chunk_origin()[a]) + world.chunk_dims()[a]) * c - 1, m));
   }
-  return {vlo, vhi - vlo + 1};
+  return {lo, glm::max(hi - lo + 1, glm::ivec3(0))};  // empty for a world of no chunks
 }
 
 // `region` cut into blocks for the workers (see kBlockEdge). `busy`: where
@@ -77,8 +68,8 @@ VoxelBox chunk_voxel_box(const World& world, int m) {
 std::vector<VoxelBox> update_blocks(const VoxelBox& region, const VoxelBox& busy, int workers) {
   std::vector<VoxelBox> blocks = detail::split_blocks(region, kBlockEdge);
   if (busy.empty()) return blocks;
+  const auto holds_work = [&](const VoxelBox& b) { return !intersect(b, busy).empty(); };
   for (int edge = kBlockEdge / 2; edge >= kSmallestBlockEdge; edge /= 2) {
-    const auto holds_work = [&](const VoxelBox& b) { return !intersect(b, busy).empty(); };
     if (std::count_if(blocks.begin(), blocks.end(), holds_work) >= kBusyBlocksPerWorker * workers) break;
     blocks = detail::split_blocks(region, edge);
   }
@@ -334,8 +325,8 @@ Status Cascades::voxelize_regions(const World& world, int level, const std::vect
   const LevelArrays arrays{&occupancy_[size_t(level)], &own_faces_[size_t(level)], &propagated_faces_[size_t(level)]};
   static thread_local detail::BlockPair scratch;  // reused across calls: no allocation per frame
   tbb::enumerable_thread_specific<detail::BlockCounters> counters;
-  // Only a whole level is worth the pass over the chunk table (scrolling
-  // slabs are many thin blocks already).
+  // Only a whole level is cut finer (scrolling slabs are many thin blocks
+  // already).
   const bool whole_level = regions.size() == 1 && intersect(regions[0], box).count() == box.count();
   const VoxelBox busy = whole_level ? chunk_voxel_box(world, land.m) : VoxelBox{};
   const int workers = tbb::this_task_arena::max_concurrency();
