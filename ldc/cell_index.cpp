@@ -140,6 +140,28 @@ void mark_empty_radius(CellIndex* index) {
   }
 }
 
+// Whether every chunk of the cube [lo, hi) is empty.
+bool all_empty(const World& world, const glm::ivec3& lo, const glm::ivec3& hi) {
+  for (int z = lo.z; z < hi.z; ++z)
+    for (int y = lo.y; y < hi.y; ++y)
+      for (int x = lo.x; x < hi.x; ++x)
+        if (world.chunk_kind({x, y, z}) != ChunkKind::kEmpty) return false;
+  return true;
+}
+
+// The chunks within r - 1 of c are clear outside when each one's sources
+// (itself and its +x, +y, +z neighbours and their sums) are empty: the cube
+// [c - (r - 1), c + r) of chunks.
+bool clear_within(const World& world, const glm::ivec3& c, int r) {
+  return all_empty(world, c - (r - 1), c + r);
+}
+
+int clear_radius_of(const World& world, const glm::ivec3& c) {
+  int r = 1;
+  while (r < CellIndex::kMaxClearRadius && clear_within(world, c, r + 1)) ++r;
+  return r;
+}
+
 }  // namespace
 
 size_t CellIndex::memory_bytes() const {
@@ -151,7 +173,7 @@ bool index_current(const CellIndex& index, const World& world, const glm::ivec3&
     const glm::ivec3 ch = c + kIndexSourceOffsets[size_t(s)];
     if (world.chunk(ch) != index.sources[size_t(s)].get() || world.chunk_kind(ch) != index.kinds[size_t(s)]) return false;
   }
-  return true;
+  return index.clear_radius == 1 || clear_within(world, c, index.clear_radius);
 }
 
 std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3& chunk) {
@@ -169,6 +191,7 @@ std::unique_ptr<CellIndex> build_cell_index(const World& world, const glm::ivec3
   if (uniform) {
     index->clear = true;
     index->clear_inside = index->kinds[0] == ChunkKind::kSolid;
+    if (index->kinds[0] == ChunkKind::kEmpty) index->clear_radius = clear_radius_of(world, chunk);
     return index;
   }
   const int b = c >> kBrickShift;
@@ -222,22 +245,34 @@ void gather_edge(const World& world, const glm::ivec3& node, int axis, const glm
 // rays of each axis are neighbours in one family (ray, ray+1, ray+C, ray+C+1).
 void gather_inner_cell(const Chunk& chunk, int c, const glm::ivec3& local, CellSurface* out) {
   const uint32_t q = depth_steps_per_cell(c);
+  // The six pairs of rays (two per axis) lie in six rows of three families:
+  // each read waits on memory, so every row is requested before any is read,
+  // then every pair's points before any is added.
+  int ray0[3][2];
+  for (int a = 0; a < 3; ++a)
+    for (int dv = 0; dv <= 1; ++dv) {
+      ray0[a][dv] = (local[axis_v(a)] + dv) * c + local[axis_u(a)];
+      chunk.axis[a].prefetch_ray(ray0[a][dv]);
+    }
+  uint32_t first[3][2] = {}, n[3][2][2] = {};
   for (int a = 0; a < 3; ++a) {
     const RayFamily& family = chunk.axis[a];
-    if (family.is_uniform()) continue;
-    const int au = axis_u(a), av = axis_v(a);
+    for (int dv = 0; dv <= 1; ++dv) {
+      if (family.is_uniform() || (!family.holds_points(ray0[a][dv]) && !family.holds_points(ray0[a][dv] + 1))) continue;
+      first[a][dv] = family.first_point(ray0[a][dv], n[a][dv]);
+      family.prefetch_points(first[a][dv]);
+    }
+  }
+  for (int a = 0; a < 3; ++a) {
+    const RayFamily& family = chunk.axis[a];
     const uint32_t lo = uint32_t(local[a]) * q;
     for (int dv = 0; dv <= 1; ++dv) {
-      const int ray0 = (local[av] + dv) * c + local[au];
-      if (!family.holds_points(ray0) && !family.holds_points(ray0 + 1)) continue;
-      uint32_t n[2];
-      const uint32_t first = family.first_point(ray0, n);
-      const uint32_t n0 = n[0], n1 = n[1];
+      const uint32_t n0 = n[a][dv][0], n1 = n[a][dv][1];
       glm::dvec3 node(0.0);
-      node[av] = dv;
-      if (n0) add_edge_points(family, first, n0, lo, lo + q, node, a, out);
-      node[au] = 1.0;
-      if (n1) add_edge_points(family, first + n0, n1, lo, lo + q, node, a, out);
+      node[axis_v(a)] = dv;
+      if (n0) add_edge_points(family, first[a][dv], n0, lo, lo + q, node, a, out);
+      node[axis_u(a)] = 1.0;
+      if (n1) add_edge_points(family, first[a][dv] + n0, n1, lo, lo + q, node, a, out);
     }
   }
 }

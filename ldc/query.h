@@ -26,7 +26,8 @@
 // `started_inside` set and the normal pointing back along the direction.
 //
 // Speed. Queries walk the lattice cell by cell but skip, whole, every 4^3 brick
-// and every chunk that holds no surface: per chunk a few kilobytes of bits are
+// and every chunk that holds no surface (and a cube of up to 5^3 chunks when
+// all of them are empty air): per chunk a few kilobytes of bits are
 // derived on first use (tens of microseconds) and kept until the chunk or one
 // of its neighbours changes; an edit therefore costs later queries only the
 // re-derivation of the chunks it changed.

@@ -172,6 +172,19 @@ class RayFamily {
     return code < kOnePoint ? 0u : code == kOnePoint ? 1u : several_count(ray);
   }
   size_t point_count() const { return points_.size(); }
+  // Starts loading what first_point(ray) reads, so that a caller about to
+  // read several rays waits for memory once, not once per ray.
+  void prefetch_ray(int ray) const {
+    if (is_uniform()) return;
+    if (!first_.empty()) {
+      __builtin_prefetch(first_.data() + ray);
+      return;
+    }
+    __builtin_prefetch(codes_.data() + (size_t(ray) >> 5));
+    __builtin_prefetch(rows_.data() + 2 * size_t(ray / size_));
+  }
+  // The same for the points from index `first` of all_points() on.
+  void prefetch_points(uint32_t first) const { __builtin_prefetch(points_.data() + first); }
   size_t memory_bytes() const;
 
   // Raw arrays, for file I/O and validate(); empty when uniform.

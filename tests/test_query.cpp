@@ -11,6 +11,7 @@
 #include "contour/contour.h"
 #include "csg/csg.h"
 #include "ldc/build.h"
+#include "ldc/detail/cell_index.h"
 #include "ldc/query.h"
 #include "ldc/terrain.h"
 #include "test_util.h"
@@ -391,6 +392,35 @@ TEST(RayCast, AfterRandomEditsEqualsAFreshCache) {
       ASSERT_EQ(a.material, c.material) << "edit " << edit;
     }
   }
+}
+
+TEST(RayCast, SeesABuildInsideACubeOfClearChunksItSkippedBefore) {
+  // A ray through empty chunks leaves a cube of them at once
+  // (CellIndex::clear_radius). A build in such a cube, in a chunk that is
+  // none of the skipping chunk's own sources (its -x neighbour), must still
+  // be seen.
+  WorldEditor editor(build_primitive(sphere(1.0, glm::dvec3(0.0)), 0.05));
+  ASSERT_TRUE(editor.apply(Brush::sphere(glm::dvec3(10.0, 0.0, 0.0), 0.5), EditOp::kUnion).ok());
+  Queries queries(editor.world());
+  const Ray ray{glm::dvec3(9.0, 0.013, 0.021), glm::dvec3(-1.0, 0.0, 0.0)};
+  EXPECT_NEAR(queries.ray_cast(ray).value().distance, 8.0, 0.01);
+  const World& w = editor.world();
+  const glm::dvec3 centre(5.6, 0.0, 0.0);
+  const double radius = 0.25;
+  const glm::ivec3 target = w.chunk_of_node(glm::ivec3(glm::floor(w.lattice().to_lattice(centre))));
+  for (double x : {centre.x - radius, centre.x + radius}) {
+    const glm::ivec3 node(glm::floor(w.lattice().to_lattice(glm::dvec3(x, 0.0, 0.0))));
+    ASSERT_EQ(w.chunk_of_node(node), target) << "the build should fill one chunk";
+  }
+  ASSERT_GE(queries.cell_index(target + glm::ivec3(1, 0, 0))->clear_radius, 2)
+      << "the ray should skip the build's chunk from its +x neighbour";
+  ASSERT_TRUE(editor.apply(Brush::sphere(centre, radius), EditOp::kUnion).ok());
+  const RayHit after = queries.ray_cast(ray).value();
+  EXPECT_NEAR(after.distance, 9.0 - (centre.x + radius), 0.01);
+  Queries fresh(editor.world());
+  const RayHit expected = fresh.ray_cast(ray).value();
+  EXPECT_EQ(after.distance, expected.distance);
+  EXPECT_EQ(after.material, expected.material);
 }
 
 TEST(RayCast, CellSurfacesKeptByAThreadFollowEdits) {

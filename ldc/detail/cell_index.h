@@ -48,6 +48,13 @@ struct CellIndex {
   std::vector<uint8_t> empty_radius;
   // Local cells [busy_lo, busy_hi) hold every surface and inside cell (brick-aligned).
   glm::ivec3 busy_lo{0}, busy_hi{0};
+  // For a clear chunk outside the solid: r >= 1 such that every chunk within
+  // Chebyshev distance r - 1 is one too (all chunks within r - 1 of it, and
+  // one more layer above, are empty), so that a ray leaves that cube of
+  // chunks in one step: camera rays cross several such chunks before they
+  // reach the surface. 1 for every other chunk. index_current checks it.
+  int clear_radius = 1;
+  static constexpr int kMaxClearRadius = 3;
 
   static int cell_bit(const glm::ivec3& l) { return (((l.z & 3) << 2 | (l.y & 3)) << 2) | (l.x & 3); }
   int brick_of(const glm::ivec3& l) const {

@@ -97,8 +97,9 @@ void walk_cells(const Queries& queries, const World& world, const glm::dvec3& o,
       if (index->clear_inside) {
         if (visit(cell, CellKind::kInside, t, t_stop, entry_axis)) return;
       }
-      block_lo = ch * c;
-      block_hi = block_lo + c;
+      // Out of the chunk, or of the cube of clear chunks around it.
+      block_lo = (ch - (index->clear_radius - 1)) * c;
+      block_hi = (ch + index->clear_radius) * c;
     } else if (const int r = index->empty_radius[size_t(index->brick_of(local))]; r > 0) {
       // Every brick within r - 1 of this one (in the chunk) is empty: leave that cube.
       const glm::ivec3 brick = local >> kBrickShift;
