@@ -50,7 +50,10 @@ void Queries::refresh() {
     for (int y = 0; y < slot_dims_.y; ++y)
       for (int x = 0; x < slot_dims_.x; ++x, ++i) {
         CellIndex* e = slots_[i].load(std::memory_order_relaxed);
-        if (e && !detail::index_current(*e, *world_, slot_origin_ + glm::ivec3(x, y, z))) {
+        if (!e || e->checked_stamp.load(std::memory_order_relaxed) == world_->stamp()) continue;  // checked against this world
+        // A cube of clear chunks would be checked chunk by chunk (up to 125
+        // of them): dropped instead, and derived again if a ray comes by.
+        if (e->clear_radius > 1 || !detail::index_current(*e, *world_, slot_origin_ + glm::ivec3(x, y, z))) {
           delete e;
           slots_[i].store(nullptr, std::memory_order_relaxed);
         }

@@ -421,6 +421,9 @@ TEST(RayCast, SeesABuildInsideACubeOfClearChunksItSkippedBefore) {
   const RayHit expected = fresh.ray_cast(ray).value();
   EXPECT_EQ(after.distance, expected.distance);
   EXPECT_EQ(after.material, expected.material);
+  // refresh() drops such cubes rather than checking them chunk by chunk.
+  queries.refresh();
+  EXPECT_EQ(queries.ray_cast(ray).value().distance, expected.distance);
 }
 
 TEST(RayCast, CellSurfacesKeptByAThreadFollowEdits) {
