@@ -140,20 +140,16 @@ void mark_empty_radius(CellIndex* index) {
   }
 }
 
-// Whether every chunk of the cube [lo, hi) is empty.
-bool all_empty(const World& world, const glm::ivec3& lo, const glm::ivec3& hi) {
+// The chunks within r - 1 of c are clear outside when each one's sources
+// (itself and its +x, +y, +z neighbours and their sums) are empty: when
+// every chunk of the cube [c - (r - 1), c + r) is.
+bool clear_within(const World& world, const glm::ivec3& c, int r) {
+  const glm::ivec3 lo = c - (r - 1), hi = c + r;
   for (int z = lo.z; z < hi.z; ++z)
     for (int y = lo.y; y < hi.y; ++y)
       for (int x = lo.x; x < hi.x; ++x)
         if (world.chunk_kind({x, y, z}) != ChunkKind::kEmpty) return false;
   return true;
-}
-
-// The chunks within r - 1 of c are clear outside when each one's sources
-// (itself and its +x, +y, +z neighbours and their sums) are empty: the cube
-// [c - (r - 1), c + r) of chunks.
-bool clear_within(const World& world, const glm::ivec3& c, int r) {
-  return all_empty(world, c - (r - 1), c + r);
 }
 
 int clear_radius_of(const World& world, const glm::ivec3& c) {
