@@ -113,6 +113,10 @@ Status check_gi_config(const GiConfig& config) {
     s << "query_offset " << config.query_offset << " must be in 0 .. 4";
     return bad(s.str());
   }
+  if (config.query_rays < 0 || config.query_rays > kGiMaxQueryRays) {
+    return bad("query_rays " + std::to_string(config.query_rays) + " must be in 0 .. " +
+               std::to_string(kGiMaxQueryRays));
+  }
   return {};
 }
 
@@ -176,6 +180,25 @@ void fill_light_params(const GiLights& lights, const GiConfig& config, GiLayout&
   if (config.light_volume) inject_point_lights(lights.points, out);
 }
 
+// Cone i's query rays (GiConfig::query_rays): n directions spread evenly
+// over it (cos >= 7/8): rings of equal solid angle, turned by the golden
+// angle. Computed here once, so that every device marches the same rays.
+void fill_query_rays(int n, GiParams& p) {
+  for (int i = 0; i < kGiDirections; ++i) {
+    const glm::dvec3 d(gi_directions()[size_t(i)]);
+    const glm::dvec3 a = std::abs(d.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+    const glm::dvec3 u = glm::normalize(glm::cross(d, a)), w = glm::cross(d, u);
+    for (int k = 0; k < kGiMaxQueryRays; ++k) {
+      glm::vec4& out = p.rays[i * kGiMaxQueryRays + k];
+      out = glm::vec4(0.0f);
+      if (k >= n) continue;
+      const double ct = 1.0 - (k + 0.5) / n * (1.0 - 0.875), st = std::sqrt(1.0 - ct * ct);
+      const double phi = 2.399963229728653 * k;
+      out = glm::vec4(glm::vec3(glm::normalize(d * ct + u * (st * std::cos(phi)) + w * (st * std::sin(phi)))), 0.0f);
+    }
+  }
+}
+
 void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfig& config, GiLayout& out) {
   GiParams& p = out.params;
   for (int i = 0; i < kGiDirections; ++i) p.dirs[i] = glm::vec4(gi_directions()[size_t(i)], 0.0f);
@@ -183,6 +206,8 @@ void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfi
   p.iparams = glm::ivec4(out.n, out.k,
                          (config.precombined ? 1 : 0) | (config.near_far ? 2 : 0) | (config.light_volume ? 4 : 0), 0);
   p.fparams2 = glm::vec4(config.near_far_split, 0.0f, 0.0f, 0.0f);
+  p.iparams2 = glm::ivec4(config.query_rays, 0, 0, 0);
+  fill_query_rays(config.query_rays, p);
   for (int l = 0; l < out.k; ++l) {
     p.lo[l] = glm::ivec4(cascades.level_box(l).lo, 0);
     p.surf[l] = glm::ivec4(out.level_first[size_t(l)], out.level_count[size_t(l)], 0, 0);

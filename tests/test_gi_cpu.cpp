@@ -57,6 +57,13 @@ TEST(GiConfig, BadValuesAreNamed) {
   c = GiConfig{};
   c.near_far_split = 0.5f;
   EXPECT_NE(check_gi_config(c).message().find("near_far_split 0.5"), std::string::npos);
+  c = GiConfig{};
+  c.query_rays = kGiMaxQueryRays + 1;
+  EXPECT_NE(check_gi_config(c).message().find("query_rays 17 must be in 0 .. 16"), std::string::npos);
+  c.query_rays = -1;
+  EXPECT_FALSE(check_gi_config(c).ok());
+  c.query_rays = 0;
+  EXPECT_TRUE(check_gi_config(c).ok());
   GiLights l;
   l.points.resize(9);
   EXPECT_NE(check_gi_lights(l, GiConfig{}).message().find("9 point lights: at most 8 exact"), std::string::npos);

@@ -21,10 +21,12 @@ struct GiParams {
   glm::vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset, w unused
   glm::ivec4 iparams;  // x N, y K, z flags, w exact point lights
   glm::vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
+  glm::ivec4 iparams2;  // x rays per cone of the queries (GiConfig::query_rays), yzw unused
   glm::ivec4 lo[kGiMaxLevels];
   glm::ivec4 surf[kGiMaxLevels];  // per level x first updated surface voxel, y their count
+  glm::vec4 rays[kGiDirections * kGiMaxQueryRays];  // cone i's query rays at i * kGiMaxQueryRays + k (unit xyz)
 };
-static_assert(sizeof(GiParams) == 16 * (16 + 16 + 8 + 8 + 1 + 1 + 1 + 16 + 16));
+static_assert(sizeof(GiParams) == 16 * (16 + 16 + 8 + 8 + 1 + 1 + 1 + 1 + 16 + 16 + 16 * kGiMaxQueryRays));
 
 struct GiPush {
   int first = 0;

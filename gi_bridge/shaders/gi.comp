@@ -17,8 +17,10 @@ layout(std140, binding = 0) uniform Params {
   vec4 fparams;   // x level 0 voxel size, y third bounce boost, z query offset (voxels), w unused
   ivec4 iparams;  // x N, y K, z flags, w exact point lights
   vec4 fparams2;  // x near/far split distance (voxels of the updated level), yzw unused
+  ivec4 iparams2;  // x rays per cone of the queries (GiConfig::query_rays), yzw unused
   ivec4 lo[16];
   ivec4 surf[16];  // per level x first updated surface voxel, y their count
+  vec4 rays[256];  // cone i's query rays at i * 16 + k (unit xyz)
 } P;
 
 layout(push_constant) uniform Push {

@@ -183,6 +183,12 @@ TEST(GiVulkan, MatchesTheCpuReferenceWithNearFarSplitCones) {
   expect_engines_agree(c, 2);
 }
 
+TEST(GiVulkan, MatchesTheCpuReferenceWithConesForQueries) {
+  GiConfig c;
+  c.query_rays = 0;
+  expect_engines_agree(c, 3);
+}
+
 TEST(GiVulkan, MatchesTheCpuReferenceWithInjectedPointLights) {
   GiConfig c;
   c.light_volume = true;
