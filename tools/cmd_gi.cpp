@@ -40,6 +40,7 @@ struct GiArgs {
   std::string up = "auto";
   CameraArgs camera;
   int levels = 6, resolution = 32, passes = 3, bounces = 3, samples = 16;
+  int query_rays = GiConfig{}.query_rays;
   double voxel_size = 0.0;  // 0: 2 h
   float exposure = 1.0f;
   bool reference = false;
@@ -57,6 +58,9 @@ contoured mesh (--samples paths per pixel) and writes it to the right of the GI 
 --light x,y,z,I (or x,y,z,r,g,b) adds a point light of intensity I at a world point
 (irradiance I / r^2 facing it); at most 8, or 65536 with --light-volume, which injects
 them into a cascaded light volume as the talk does (less exact, see docs/gi.md).
+The image's final gather traces each of the 16 cones as --query-rays narrow rays where
+the air is open to the sky (cones darken surfaces they graze); 0 keeps the cones,
+about 4 times faster on the CPU engine.
 )";
 
 // The default sky and the --light point lights.
@@ -204,6 +208,7 @@ void print_report(const GiArgs& a, const GiLights& lights, const GiRun& r, bool 
                      {"voxel_size", r.cascades.voxel_size},
                      {"surface_voxels", surface_voxels},
                      {"passes", a.passes},
+                     {"query_rays", a.query_rays},
                      {"up", axis_name(r.up_axis)},
                      {"point_lights", {{"count", lights.points.size()}, {"mode", a.light_volume ? "injected volume" : "exact"}}},
                      {"seconds", {{"voxelize", r.voxelize_seconds}, {"lighting", r.lighting.seconds}, {"lighting_device", r.lighting.device_seconds}, {"image", r.image_seconds}}},
@@ -243,6 +248,9 @@ Status check_args(const GiArgs& a) {
     return Status(ErrorCode::kInvalidArgument, "--passes " + std::to_string(a.passes) + ": must be 1 .. 16");
   if (a.bounces < 1 || a.bounces > 3)
     return Status(ErrorCode::kInvalidArgument, "--bounces " + std::to_string(a.bounces) + ": must be 1 .. 3");
+  if (a.query_rays < 0 || a.query_rays > kGiMaxQueryRays)
+    return Status(ErrorCode::kInvalidArgument, "--query-rays " + std::to_string(a.query_rays) + ": must be 0 .. " +
+                                                   std::to_string(kGiMaxQueryRays));
 #ifndef LDC_HAVE_GI_REFERENCE
   if (a.reference)
     return Status(ErrorCode::kUnsupported, "--reference: built without Embree 3 (the path tracer's ray caster)");
@@ -263,6 +271,7 @@ Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, 
   r.voxelize_seconds = t_vox.seconds();
   GiConfig gi_config;
   gi_config.light_volume = a.light_volume;
+  gi_config.query_rays = a.query_rays;
   Result<std::unique_ptr<GiEngine>> gi = make_engine(a.engine, gi_config, &r.device);
   if (!gi.ok()) return gi.status();
   if (Status s = gi.value()->load(cas.value(), lights); !s.ok()) return s;
@@ -330,6 +339,9 @@ void add_gi_command(CLI::App& app, CommonOptions& common) {
   cmd->add_option("--voxel-size", args->voxel_size, "Level 0 voxel edge in m (default 2 h)");
   cmd->add_option("--passes", args->passes, "Lighting passes of every level")->capture_default_str();
   cmd->add_option("--bounces", args->bounces, "Bounces in the image, 1 .. 3")->capture_default_str();
+  cmd->add_option("--query-rays", args->query_rays,
+                  "Narrow rays per cone for the image's final gather in open air, 0 .. 16 (0: the cones)")
+      ->capture_default_str();
   cmd->add_option("--exposure", args->exposure, "Exposure before tone mapping")->capture_default_str();
   cmd->add_flag("--reference", args->reference, "Also path-trace the view (Embree) and put it on the right");
   cmd->add_option("--samples", args->samples, "Paths per pixel of --reference")->capture_default_str();
