@@ -34,6 +34,7 @@ struct Buffers {
 
 #define GI_CONST static constexpr
 #define OUT(T) T&
+#define GI_INLINE [[gnu::always_inline]]
 #define INOUT(T) T&
 #define XYZ(v) vec3(v)
 #define IXYZ(v) ivec3(v)
@@ -70,6 +71,7 @@ struct Kernels {
 #undef INOUT
 #undef XYZ
 #undef IXYZ
+#undef GI_INLINE
 
 class CpuGi final : public GiEngineBase {
  public:

@@ -4,6 +4,7 @@
 layout(local_size_x = 64) in;
 
 #define GI_CONST const
+#define GI_INLINE
 #define OUT(T) out T
 #define INOUT(T) inout T
 #define XYZ(v) (v).xyz

@@ -3,7 +3,8 @@
 // included by the CPU reference (gi_cpu.cpp) inside a struct, so that both
 // run the same algorithm step for step. Conventions that keep it both:
 // float literals carry an f suffix, conversions are written T(x), out and
-// inout parameters go through OUT(T) / INOUT(T), and the data is reached
+// inout parameters go through OUT(T) / INOUT(T), GI_INLINE asks the C++
+// compiler to inline a hot function (empty in GLSL), and the data is reached
 // through accessor functions each side defines (occ_load, light_load, ...),
 // plus the uniform block P and the push constants pc.
 //
@@ -144,7 +145,10 @@ float voxel_alpha(int voxel, int dir) {
 
 // d: the direction of travel (the cone's axis, or a ray of it); dir: the
 // cone whose buffers (opacity and light seen along its axis) stand for it.
-void sample_corner(int l, ivec3 c, vec3 d, int dir, float w, vec3 apex, INOUT(ConeSample) cs) {
+// Inlined into the marches on the CPU engine (GI_INLINE): called from the
+// cones' and the rays' marches, gcc stopped inlining it and the cones took
+// 1.8 times as long.
+GI_INLINE void sample_corner(int l, ivec3 c, vec3 d, int dir, float w, vec3 apex, INOUT(ConeSample) cs) {
   if (!corner_ahead(l, c, d, apex)) return;
   float size = level_size(l);
   vec3 centre = voxel_centre(l, c);
@@ -298,7 +302,7 @@ float empty_run(int l, vec3 u, vec3 p, vec3 d, int dir) {
 // 1 / |p - lit|^2, not as the cone's 1 / t^2 from its apex: a query's apex
 // sits a voxel above the surface, and without the correction a light 1.75
 // voxels above a plane gave 1.7 times its irradiance.
-ConeResult march_lit(vec3 apex, vec3 lit, vec3 d, int dir, float tan_half, bool skip_empty, int max_steps, int l0,
+GI_INLINE ConeResult march_lit(vec3 apex, vec3 lit, vec3 d, int dir, float tan_half, bool skip_empty, int max_steps, int l0,
                      float t0, float t1) {
   ConeResult r;
   r.src = vec3(0.0f);
