@@ -11,8 +11,9 @@
 // (the closed room with the sky outside) report the cone tracer's mean
 // radiance instead, which must be 0. With DIR, each view is written as
 // DIR/gi_<view>.png: the cone tracer (CPU engine) on the left, the
-// reference on the right. BENCH_GI_VIEW picks views by substring and
-// BENCH_GI_BOUNCES=1 or 2 compares the first bounces alone (both sides).
+// reference on the right. BENCH_GI_VIEW picks views by substring,
+// BENCH_GI_BOUNCES=1 or 2 compares the first bounces alone (both sides) and
+// BENCH_GI_QUERY_RAYS sets GiConfig::query_rays (0: the cones themselves).
 #include "gi_images.h"
 #include "scene_builders.h"
 
@@ -78,6 +79,13 @@ int bounces() {
   const char* b = std::getenv("BENCH_GI_BOUNCES");
   const int n = b ? std::atoi(b) : 3;
   return n >= 1 && n <= 3 ? n : 3;
+}
+
+// BENCH_GI_QUERY_RAYS: GiConfig::query_rays (the default when unset).
+GiConfig engine_config() {
+  GiConfig c;
+  if (const char* r = std::getenv("BENCH_GI_QUERY_RAYS")) c.query_rays = std::clamp(std::atoi(r), 0, kGiMaxQueryRays);
+  return c;
 }
 
 float lum(const glm::vec3& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
@@ -183,9 +191,9 @@ void run_view(const View& v, int paths, const char* dir, bool with_vulkan) {
     std::string device = "cpu";
     std::unique_ptr<GiEngine> gi;
     if (engine == 0) {
-      gi = make_cpu_gi();
+      gi = make_cpu_gi(engine_config());
     } else {
-      Result<std::unique_ptr<GiEngine>> vk = make_vulkan_gi({}, &device);
+      Result<std::unique_ptr<GiEngine>> vk = make_vulkan_gi(engine_config(), &device);
       if (!vk.ok()) continue;
       gi = std::move(vk).value();
     }
@@ -317,7 +325,7 @@ void visibility_row(const View& v, int rays) {
   if (!cam.ok()) return;
   const std::vector<SurfacePoint> pts = sample_pixels(v, cam.value(), 4);
   Queries q(*v.world);
-  std::unique_ptr<GiEngine> gi = make_cpu_gi();
+  std::unique_ptr<GiEngine> gi = make_cpu_gi(engine_config());
   Result<Cascades> black = black_cascades(v, cam.value());
   if (!black.ok()) {
     std::printf("| %s | failed: %s |\n", v.name.c_str(), black.status().message().c_str());
@@ -385,9 +393,10 @@ void gi_images(int paths, const char* dir, bool with_vulkan) {
     return;
   }
   std::printf("\n## Whole images against the path tracer (issue 25)\n");
-  std::printf("%d x %d pixels, %d bounces, cascades of 6 levels of 32^3 voxels of 2 h centred on the camera, 3 passes; "
+  std::printf("%d x %d pixels, %d bounces, cascades of 6 levels of 32^3 voxels of 2 h centred on the camera, 3 passes, "
+              "final gather from open air: %d rays per cone (GiConfig::query_rays; 0: the cones); "
               "reference: mean of 2 path-traced images of %d paths per pixel (seeds 1, 2)\n",
-              kWidth, kHeight, bounces(), paths);
+              kWidth, kHeight, bounces(), engine_config().query_rays, paths);
   std::printf("| view | engine | rel. L1 | rel. L1, darkest fifth | brightness | reference noise (seed 2 vs 1) | paths |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   for (const View& v : sc.value()->views)

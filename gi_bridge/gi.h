@@ -27,6 +27,14 @@
 // half-voxel step: 1 - sqrt(1 - a)). A cone that leaves the coarsest
 // level receives the sky times its transmittance.
 //
+// Queries (irradiance(), an image's final gather) from air open to the sky
+// trace each cone as GiConfig::query_rays narrow rays spread over it (their
+// voxels at most 1/8 of their distance wide; blocks of empty voxels
+// skipped) and take their mean: a wide cone grazing a surface reads the
+// half-covered voxels beside it as a new layer at every step and darkens
+// what it lights (issue 25). Queries from sealed air and the voxel updates
+// keep the cones.
+//
 // Light. Per surface voxel and face the cascades hold three radiance buffers
 // (the talk's volumetric light buffers): D = emission + direct light of sky
 // and point lights reflected once, B1 = D gathered and reflected, B2 = B1

@@ -82,10 +82,11 @@ std::vector<glm::vec3> path_traced(const World& world, const GiLights& lights, c
 // crossed metres of ground through coarse voxels whose corners they
 // skipped: 12 and 15 m into the tunnel (x = 35, 32) the floor got 0.25 and
 // 0.22 where the path tracer finds 0.03 and 0.011 (about 8 and 20 times;
-// measured with the east half of the tunnel dug). Now 0.018 and 0.003.
-// Where the tunnel is lit the cone tracer is within 0.48 .. 1.43 of the
-// path tracer (measured; issue 25 asks for 25%, which the 16 wide cones
-// miss where the mouth fills part of a cone).
+// measured with the east half of the tunnel dug). With the cones for the
+// queries, 0.018 and 0.003; with the queries' narrow rays (the default),
+// 0.008 and 0.0007: eight rays per cone undersample a sky seen through a
+// small opening. Where the tunnel is lit the rays read 0.50 .. 0.85 of the
+// path tracer (the cones 0.48 .. 1.43; issue 25 asks for 25%).
 TEST(GiCaves, SkyInATunnelFallsOffFromItsMouthAsThePathTracerSays) {
   const World world = main_job_tunnel();
   GiLights lights;
@@ -102,7 +103,7 @@ TEST(GiCaves, SkyInATunnelFallsOffFromItsMouthAsThePathTracerSays) {
     SCOPED_TRACE("x " + std::to_string(kFloorX[i]) + ": cone " + std::to_string(c) + ", path " + std::to_string(r));
     if (r >= 0.1f * mouth) {
       EXPECT_GT(c, 0.4f * r);
-      EXPECT_LT(c, 1.75f * r);
+      EXPECT_LT(c, 1.25f * r);
     } else {
       EXPECT_LT(c, r + 0.05f * mouth);  // no sky through the ground
     }
