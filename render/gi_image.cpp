@@ -3,11 +3,35 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <vector>
+
+#include "ldc/context.h"
 
 #include "render/render.h"
 
 namespace ldc {
+
+namespace {
+
+// The engine's irradiance in blocks of at least 4096 points, about 32 in
+// all, so that a long final gather (seconds on lavapipe) reports progress
+// and can be cancelled. Each point's answer does not depend on its block.
+Status irradiance_in_blocks(GiEngine& gi, std::span<const glm::dvec3> p, std::span<const glm::vec3> n, int bounces,
+                            std::span<glm::vec3> e, Context* ctx) {
+  const size_t block = std::max<size_t>(4096, (p.size() + 31) / 32);
+  for (size_t first = 0; first < p.size(); first += block) {
+    if (ctx && ctx->cancelled()) return Status(ErrorCode::kCancelled, "gi image: cancelled");
+    const size_t count = std::min(block, p.size() - first);
+    if (Status s = gi.irradiance(p.subspan(first, count), n.subspan(first, count), bounces, e.subspan(first, count));
+        !s.ok())
+      return s;
+    if (ctx) ctx->report_progress("gi image", double(first + count) / double(p.size()));
+  }
+  return {};
+}
+
+}  // namespace
 
 Result<RadianceImage> render_gi(const Queries& queries, const Camera& cam, GiEngine& gi,
                                 const GiImageOptions& options) {
@@ -37,7 +61,7 @@ Result<RadianceImage> render_gi(const Queries& queries, const Camera& cam, GiEng
     pix.push_back(i);
   }
   std::vector<glm::vec3> e(p.size());
-  if (Status s = gi.irradiance(p, nrm, bounces, e); !s.ok()) return s;
+  if (Status s = irradiance_in_blocks(gi, p, nrm, bounces, e, options.ctx); !s.ok()) return s;
   for (size_t k = 0; k < pix.size(); ++k) {
     const VoxelMaterial& m = materials[hits[pix[k]].material];
     out.pixels[pix[k]] = m.albedo * e[k] * (1.0f / std::numbers::pi_v<float>) + m.emission;

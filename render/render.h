@@ -174,6 +174,9 @@ struct GiImageOptions {
   MaterialTable materials = default_material_table();  // albedo and emission per material id
   SkyLight sky;                                        // what misses show
   int bounces = 1;  // as GiEngine::irradiance [Limit: 1 .. 3]
+  // Progress (stage "gi image", after each block of queries) and
+  // cancellation (checked between blocks: kCancelled, no image). nullptr: none.
+  Context* ctx = nullptr;
 };
 
 // Primary hits by ray cast, one irradiance query per hit: albedo / pi *

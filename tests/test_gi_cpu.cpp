@@ -7,6 +7,9 @@
 
 #include "gi/gi_scenes.h"
 #include "gi_bridge/gi.h"
+#include "ldc/context.h"
+#include "ldc/query.h"
+#include "render/render.h"
 
 namespace ldc {
 namespace {
@@ -203,6 +206,42 @@ TEST(GiCpu, GlowingClosedRoomGivesTheFurnaceIrradiance) {
   // 0.81 .. 0.92 after 3 (the corners' cones lose the most).
   const std::vector<std::vector<float>> ratio = test::furnace_ratios(test::build_boxes(test::closed_room(2)));
   test::expect_furnace_ratios(ratio, {0.85f, 0.8f, 0.75f});
+}
+
+// render_gi queries the engine in blocks (at least 4096 points, about 32
+// in all): progress after each, up to the whole image, and a cancelled
+// context stops it with kCancelled. The blocks do not change the image.
+TEST(RenderGi, ReportsProgressPerBlockAndStopsWhenCancelled) {
+  const World world = test::build_boxes({{{-30, -30, -1}, {30, 30, 0}, 1}});
+  const Cascades cas = test::make_cascades(world, glm::dvec3(0.0));
+  auto gi = make_cpu_gi();
+  ASSERT_TRUE(gi->load(cas, GiLights{.sky = SkyLight::uniform(glm::vec3(1.0f))}).ok());
+  ASSERT_TRUE(gi->update_all(1).ok());
+  CameraConfig cc;
+  cc.position = glm::dvec3(0, 0, 3);
+  cc.target = glm::dvec3(0.5, 0.2, 0);
+  cc.width = 96;
+  cc.height = 64;  // 6144 hits: blocks of 4096 and 2048
+  const Result<Camera> cam = Camera::make(cc, &world);
+  ASSERT_TRUE(cam.ok());
+  const Queries queries(world);
+  Context ctx;
+  std::vector<double> reported;
+  ctx.set_progress([&](std::string_view stage, double f) {
+    EXPECT_EQ(stage, "gi image");
+    reported.push_back(f);
+  });
+  const Result<RadianceImage> img = render_gi(queries, cam.value(), *gi, {.ctx = &ctx});
+  ASSERT_TRUE(img.ok()) << img.status().message();
+  ASSERT_EQ(reported.size(), 2u);
+  EXPECT_NEAR(reported[0], 4096.0 / 6144.0, 1e-12);
+  EXPECT_EQ(reported[1], 1.0);
+  const Result<RadianceImage> plain = render_gi(queries, cam.value(), *gi, {});
+  ASSERT_TRUE(plain.ok());
+  EXPECT_EQ(plain.value().pixels, img.value().pixels);
+  ctx.cancel();
+  const Result<RadianceImage> cancelled = render_gi(queries, cam.value(), *gi, {.ctx = &ctx});
+  EXPECT_EQ(cancelled.status().code(), ErrorCode::kCancelled);
 }
 
 // A point light over a black open plane: irradiance I cos / r^2 exactly

@@ -260,7 +260,8 @@ Status check_args(const GiArgs& a) {
 
 // Voxelizes around the camera, lights the cascades and renders the image
 // (with the reference on the right).
-Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, const GiLights& lights, GiRun& r) {
+Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, const GiLights& lights, GiRun& r,
+                        Context* ctx) {
   r.cascades.levels = a.levels;
   r.cascades.resolution = a.resolution;
   r.cascades.voxel_size = a.voxel_size > 0.0 ? a.voxel_size : 2.0 * world.lattice().cell_size;
@@ -281,7 +282,8 @@ Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, 
   ScopedTimer t_img(nullptr, "");
   Queries queries(world);
   Result<RadianceImage> lit =
-      render_gi(queries, cam, *gi.value(), {.materials = r.cascades.materials, .sky = lights.sky, .bounces = a.bounces});
+      render_gi(queries, cam, *gi.value(),
+                {.materials = r.cascades.materials, .sky = lights.sky, .bounces = a.bounces, .ctx = ctx});
   if (!lit.ok()) return lit.status();
   r.image_seconds = t_img.seconds();
   Image image = tone_map(lit.value(), a.exposure);
@@ -317,7 +319,9 @@ int run_gi(const GiArgs& a, const CommonOptions& common) {
   run.up_axis = up_axis;
   run.width = cam.value().width();
   run.height = cam.value().height();
-  Result<Image> image = lit_image(a, w.value(), cam.value(), lights.value(), run);
+  ProgressBar image_bar(!common.quiet);
+  Result<Image> image = lit_image(a, w.value(), cam.value(), lights.value(), run, image_bar.context());
+  image_bar.finish();
   if (!image.ok()) return fail("gi", image.status());
   if (Status s = write_png(image.value(), a.output); !s.ok()) return fail("gi", "-o " + s.message());
   print_report(a, lights.value(), run, common.json);
