@@ -261,6 +261,17 @@ struct ConeResult {
   float transmittance;
 };
 
+ConeResult no_light() {
+  ConeResult r;
+  r.src = vec3(0.0f);
+  r.sky = 0.0f;
+  r.d = vec3(0.0f);
+  r.b1 = vec3(0.0f);
+  r.b2 = vec3(0.0f);
+  r.transmittance = 0.0f;
+  return r;
+}
+
 // True when the 8 voxels of level l around level coordinates u hold no
 // solid (each one's opacity along cone dir is 0).
 bool block_empty(int l, vec3 u, int dir) {
@@ -304,12 +315,7 @@ float empty_run(int l, vec3 u, vec3 p, vec3 d, int dir) {
 // voxels above a plane gave 1.7 times its irradiance.
 GI_INLINE ConeResult march_lit(vec3 apex, vec3 lit, vec3 d, int dir, float tan_half, bool skip_empty, int max_steps, int l0,
                      float t0, float t1) {
-  ConeResult r;
-  r.src = vec3(0.0f);
-  r.sky = 0.0f;
-  r.d = vec3(0.0f);
-  r.b1 = vec3(0.0f);
-  r.b2 = vec3(0.0f);
+  ConeResult r = no_light();
   float T = 1.0f;
   float t = t0;
   float base = level_size(l0);
@@ -378,13 +384,7 @@ GI_CONST int kMaxRaySteps = 640;
 int query_rays() { return P.iparams2.x; }
 
 ConeResult trace_rays_lit(vec3 apex, vec3 lit, int dir, int l0, float t0) {
-  ConeResult r;
-  r.src = vec3(0.0f);
-  r.sky = 0.0f;
-  r.d = vec3(0.0f);
-  r.b1 = vec3(0.0f);
-  r.b2 = vec3(0.0f);
-  r.transmittance = 0.0f;
+  ConeResult r = no_light();
   int n = query_rays();
   bool skip = (gi_flags() & kFlagLightVolume) == 0;
   for (int k = 0; k < n; ++k) {
