@@ -313,8 +313,8 @@ float empty_run(int l, vec3 u, vec3 p, vec3 d, int dir) {
 // 1 / |p - lit|^2, not as the cone's 1 / t^2 from its apex: a query's apex
 // sits a voxel above the surface, and without the correction a light 1.75
 // voxels above a plane gave 1.7 times its irradiance.
-GI_INLINE ConeResult march_lit(vec3 apex, vec3 lit, vec3 d, int dir, float tan_half, bool skip_empty, int max_steps, int l0,
-                     float t0, float t1) {
+GI_INLINE ConeResult march_lit(vec3 apex, vec3 lit, vec3 d, int dir, float tan_half, bool skip_empty,
+                               int max_steps, int l0, float t0, float t1) {
   ConeResult r = no_light();
   float T = 1.0f;
   float t = t0;
@@ -375,10 +375,10 @@ ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float 
 // (voxels at most 1/8 of its distance: the width of a cone of tan 1/16)
 // reads the ground beside it as it is, 0.89 of the exact sky there with 8
 // rays per cone. With 4 rays per cone, tan 1/8 saw 0.72 and tan 1/16 0.84;
-// 16 rays of tan 1/16 0.88: the width matters more than the count. Their mean stands for the cone: light, sky and
-// transmittance. Rays skip blocks of empty voxels (empty_run: 6 times
-// faster, same figures), but not through injected lights, which live in
-// the air.
+// 16 rays of tan 1/16 0.88: the width matters more than the count. Their
+// mean stands for the cone: light, sky and transmittance. Rays skip blocks
+// of empty voxels (empty_run: 6 times faster, same figures), but not
+// through injected lights, which live in the air.
 GI_CONST float kRayTan = 0.0625f;
 GI_CONST int kMaxRaySteps = 640;
 int query_rays() { return P.iparams2.x; }
