@@ -377,7 +377,7 @@ ConeResult trace_cone_lit(vec3 apex, vec3 lit, int dir, int l0, float t0, float 
 // rays per cone. With 4 rays per cone, tan 1/8 saw 0.72 and tan 1/16 0.84;
 // 16 rays of tan 1/16 0.88: the width matters more than the count. Their
 // mean stands for the cone: light, sky and transmittance. Rays skip blocks
-// of empty voxels (empty_run: 6 times faster, same figures), but not
+// of empty voxels (empty_run: 6 times faster, figures within 0.002), but not
 // through injected lights, which live in the air.
 GI_CONST float kRayTan = 0.0625f;
 GI_CONST int kMaxRaySteps = 640;
