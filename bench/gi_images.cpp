@@ -264,19 +264,12 @@ std::vector<SurfacePoint> sample_pixels(const View& v, const Camera& cam, int st
   return out;
 }
 
-// The part of cone i's rays (directions within its half-angle, cos >= 7/8,
-// spread evenly: rings in cos, golden-angle turns) from the point that
-// leave the world without meeting the solid.
-double exact_escape(const Queries& q, const SurfacePoint& sp, const glm::vec3& axis, int rays) {
-  const glm::dvec3 d(axis);
-  const glm::dvec3 a = std::abs(d.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-  const glm::dvec3 u = glm::normalize(glm::cross(d, a)), w = glm::cross(d, u);
+// The part of cone i's rays (gi_cone_ray: spread evenly within its
+// half-angle) from the point that leave the world without meeting the solid.
+double exact_escape(const Queries& q, const SurfacePoint& sp, int cone, int rays) {
   int escaped = 0;
   for (int k = 0; k < rays; ++k) {
-    const double ct = 1.0 - (k + 0.5) / rays * (1.0 - 0.875), st = std::sqrt(1.0 - ct * ct);
-    const double phi = 2.399963229728653 * k;
-    const glm::dvec3 dir = d * ct + u * (st * std::cos(phi)) + w * (st * std::sin(phi));
-    Result<RayHit> h = q.ray_cast(Ray{sp.p + 1e-3 * glm::dvec3(sp.n), dir});
+    Result<RayHit> h = q.ray_cast(Ray{sp.p + 1e-3 * glm::dvec3(sp.n), gi_cone_ray(cone, k, rays)});
     if (h.ok() && !h.value().hit) ++escaped;
   }
   return double(escaped) / rays;
@@ -342,7 +335,7 @@ void visibility_row(const View& v, int rays) {
     for (size_t k = 0; k < pts.size(); ++k) {
       const double c = glm::dot(pts[k].n, axis);
       if (c <= 0.0) continue;
-      const double e = exact_escape(q, pts[k], axis, rays), tc = t.value()[k];
+      const double e = exact_escape(q, pts[k], i, rays), tc = t.value()[k];
       cone += c * tc, exact += c * e, weight += c;
       over += c * std::max(e - tc, 0.0), leak += c * std::max(tc - e, 0.0);
     }

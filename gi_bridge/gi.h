@@ -109,6 +109,11 @@ inline constexpr int kGiMaxQueryRays = 16;  // GiConfig::query_rays
 
 // The 16 directions (see the header comment).
 const std::array<glm::vec3, kGiDirections>& gi_directions();
+// The k-th of n unit directions spread evenly over cone `cone` (cos >= 7/8
+// to its axis): rings of equal solid angle, turned by the golden angle; one
+// ray (n = 1) is the axis. The queries' rays (GiConfig::query_rays) are
+// these. [Limit: 0 <= k < n]
+glm::dvec3 gi_cone_ray(int cone, int k, int n);
 
 struct SkyLight {
   // Radiance amplitude of each lobe. [Units: radiance] [Limit: >= 0, finite]

@@ -27,6 +27,18 @@ const std::array<glm::vec3, kGiDirections>& gi_directions() {
   return dirs;
 }
 
+glm::dvec3 gi_cone_ray(int cone, int k, int n) {
+  const glm::dvec3 d(gi_directions()[size_t(cone)]);
+  // One ray stands for the whole cap: its axis (the ring rule would put it
+  // 20 degrees off, at cos 0.9375).
+  if (n == 1) return glm::normalize(d);
+  const glm::dvec3 a = std::abs(d.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
+  const glm::dvec3 u = glm::normalize(glm::cross(d, a)), w = glm::cross(d, u);
+  const double ct = 1.0 - (k + 0.5) / n * (1.0 - 0.875), st = std::sqrt(1.0 - ct * ct);
+  const double phi = 2.399963229728653 * k;  // the golden angle
+  return glm::normalize(d * ct + u * (st * std::cos(phi)) + w * (st * std::sin(phi)));
+}
+
 SkyLight SkyLight::uniform(const glm::vec3& radiance) {
   SkyLight s;
   s.amplitude.fill(radiance);
@@ -180,23 +192,12 @@ void fill_light_params(const GiLights& lights, const GiConfig& config, GiLayout&
   if (config.light_volume) inject_point_lights(lights.points, out);
 }
 
-// Cone i's query rays (GiConfig::query_rays): n directions spread evenly
-// over it (cos >= 7/8): rings of equal solid angle, turned by the golden
-// angle. Computed here once, so that every device marches the same rays.
+// Cone i's query rays (GiConfig::query_rays), computed here once so that
+// every device marches the same rays; unused slots 0.
 void fill_query_rays(int n, GiParams& p) {
-  for (int i = 0; i < kGiDirections; ++i) {
-    const glm::dvec3 d(gi_directions()[size_t(i)]);
-    const glm::dvec3 a = std::abs(d.x) < 0.9 ? glm::dvec3(1, 0, 0) : glm::dvec3(0, 1, 0);
-    const glm::dvec3 u = glm::normalize(glm::cross(d, a)), w = glm::cross(d, u);
-    for (int k = 0; k < kGiMaxQueryRays; ++k) {
-      glm::vec4& out = p.rays[i * kGiMaxQueryRays + k];
-      out = glm::vec4(0.0f);
-      if (k >= n) continue;
-      const double ct = 1.0 - (k + 0.5) / n * (1.0 - 0.875), st = std::sqrt(1.0 - ct * ct);
-      const double phi = 2.399963229728653 * k;
-      out = glm::vec4(glm::vec3(glm::normalize(d * ct + u * (st * std::cos(phi)) + w * (st * std::sin(phi)))), 0.0f);
-    }
-  }
+  for (int i = 0; i < kGiDirections; ++i)
+    for (int k = 0; k < kGiMaxQueryRays; ++k)
+      p.rays[i * kGiMaxQueryRays + k] = k < n ? glm::vec4(glm::vec3(gi_cone_ray(i, k, n)), 0.0f) : glm::vec4(0.0f);
 }
 
 void fill_params(const Cascades& cascades, const GiLights& lights, const GiConfig& config, GiLayout& out) {

@@ -24,6 +24,24 @@ GiConfig injected_lights() {
   return c;
 }
 
+// The queries' rays: unit, inside their cone (cos >= 7/8), and spread
+// around its axis (their mean lies near it).
+TEST(GiDirections, ConeRaysAreUnitInsideTheirConeAndAroundItsAxis) {
+  for (int i = 0; i < kGiDirections; ++i) {
+    const glm::dvec3 axis(gi_directions()[size_t(i)]);
+    for (int n : {1, 8, 16}) {
+      glm::dvec3 sum(0.0);
+      for (int k = 0; k < n; ++k) {
+        const glm::dvec3 d = gi_cone_ray(i, k, n);
+        EXPECT_NEAR(glm::length(d), 1.0, 1e-12);
+        EXPECT_GE(glm::dot(d, axis), 0.875 - 1e-12) << "cone " << i << ", ray " << k << " of " << n;
+        sum += d;
+      }
+      EXPECT_GT(glm::dot(glm::normalize(sum), axis), n == 1 ? 0.999 : 0.99) << "cone " << i << ", " << n << " rays";
+    }
+  }
+}
+
 TEST(GiDirections, AreASphericalFiveDesign) {
   // Mean of x^a y^b z^c over the directions equals the sphere's average for degree <= 5
   // (to the table's float rounding and the optimiser's residual, about 1e-5).

@@ -63,6 +63,14 @@ the air is open to the sky (cones darken surfaces they graze); 0 keeps the cones
 about 4 times faster on the CPU engine.
 )";
 
+// The engine's configuration the arguments ask for.
+GiConfig gi_config_of(const GiArgs& a) {
+  GiConfig c;
+  c.light_volume = a.light_volume;
+  c.query_rays = a.query_rays;
+  return c;
+}
+
 // The default sky and the --light point lights.
 Result<GiLights> parse_lights(const GiArgs& a, int up_axis) {
   GiLights l;
@@ -74,9 +82,7 @@ Result<GiLights> parse_lights(const GiArgs& a, int up_axis) {
     const glm::vec3 intensity = v.size() == 4 ? glm::vec3(float(v[3])) : glm::vec3(float(v[3]), float(v[4]), float(v[5]));
     l.points.push_back({glm::dvec3(v[0], v[1], v[2]), intensity});
   }
-  GiConfig config;
-  config.light_volume = a.light_volume;
-  if (Status s = check_gi_lights(l, config); !s.ok()) return s;
+  if (Status s = check_gi_lights(l, gi_config_of(a)); !s.ok()) return s;
   return l;
 }
 
@@ -270,10 +276,7 @@ Result<Image> lit_image(const GiArgs& a, const World& world, const Camera& cam, 
   if (!cas.ok()) return cas.status();
   if (Status s = cas.value().update_all(world, cam.position()); !s.ok()) return s;
   r.voxelize_seconds = t_vox.seconds();
-  GiConfig gi_config;
-  gi_config.light_volume = a.light_volume;
-  gi_config.query_rays = a.query_rays;
-  Result<std::unique_ptr<GiEngine>> gi = make_engine(a.engine, gi_config, &r.device);
+  Result<std::unique_ptr<GiEngine>> gi = make_engine(a.engine, gi_config_of(a), &r.device);
   if (!gi.ok()) return gi.status();
   if (Status s = gi.value()->load(cas.value(), lights); !s.ok()) return s;
   Result<GiTimings> upd = gi.value()->update_all(a.passes);

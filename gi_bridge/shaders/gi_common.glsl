@@ -696,13 +696,13 @@ void kernel_query(int gid) {
   float wsum = cosine_sum(n);
   vec3 e = vec3(0.0f);
   int bounces = pc.level;
+  // Rays where the sky can reach; in sealed air the cones, whose light the
+  // sealed gain makes whole (the rays lost light at a thin-walled room's
+  // corner, through walls one fine voxel thick).
+  bool rays = query_rays() > 0 && open > 0.0f;
   for (int i = 0; i < 16; ++i) {
     float c = max(0.0f, dot(n, XYZ(P.dirs[i])));
     if (c <= 0.0f) continue;
-    // Rays where the sky can reach; in sealed air the cones, whose light the
-    // sealed gain makes whole (the rays lost light at a thin-walled room's
-    // corner, through walls one fine voxel thick).
-    bool rays = query_rays() > 0 && open > 0.0f;
     ConeResult cr = rays ? trace_rays_lit(apex, p, i, l0, 0.5f * s) : trace_cone_lit(apex, p, i, l0, 0.5f * s, 1e30f);
     vec3 l = cr.src + (open * cr.sky) * XYZ(P.sky[i]) + cr.d;
     if (bounces >= 2) l += cr.b1;
