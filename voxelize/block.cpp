@@ -133,9 +133,10 @@ class AxisPass {
         vol[size_t(b0) * sa] += w * ((b0 + 1) * bin_steps_ - r0);
         vol[size_t(b1) * sa] += w * (r1 - b1 * bin_steps_);
         if (b1 > b0 + 1) {
-          int64_t* diff = s_.volume_diff.data() + size_t(column) * size_t(bins_ + 1);
-          diff[b0 + 1] += w;
-          diff[b1] -= w;
+          // Bin-major (bin * columns + column): the resolve reads it in voxel order.
+          const size_t cols = size_t(cols_u_) * size_t(cols_v_);
+          s_.volume_diff[size_t(b0 + 1) * cols + size_t(column)] += w;
+          s_.volume_diff[size_t(b1) * cols + size_t(column)] -= w;
         }
       }
     }
@@ -311,26 +312,44 @@ class AxisPass {
   std::vector<std::pair<int64_t, int64_t>> runs_;
 };
 
-void resolve_volume(const VoxelSource& src, BlockScratch& s) {
-  const int a = src.occ_axis, u = axis_u(a), v = axis_v(a);
+// Occupancy = the inside steps added per voxel plus the runs crossing it
+// whole (the running sum of volume_diff along its column), over full. Voxels
+// are visited in memory order (x fastest) with one running sum per column:
+// walking each column along the axis instead (4 KB apart for the z axis)
+// made this loop half of a mesh's voxelization.
+template <int A>
+void resolve_volume_along(BlockScratch& s, int64_t bin_steps, int64_t full) {
+  constexpr int U = axis_u(A), V = axis_v(A);
   const glm::ivec3 d = s.box.dims;
-  const glm::ivec3 step(1, d.x, d.x * d.y);
+  const size_t cols = size_t(d[U]) * size_t(d[V]);
+  const double inv_full = 1.0 / double(full);
+  s.volume_run.assign(cols, 0);
+  int64_t* run = s.volume_run.data();
+  const int64_t* diff = s.volume_diff.data();
+  const int64_t* volume = s.volume.data();
+  float* occupancy = s.occupancy.data();
+  size_t i = 0;
+  glm::ivec3 g;
+  for (g.z = 0; g.z < d.z; ++g.z) {
+    for (g.y = 0; g.y < d.y; ++g.y) {
+      for (g.x = 0; g.x < d.x; ++g.x, ++i) {
+        const size_t col = size_t(g[V]) * size_t(d[U]) + size_t(g[U]);
+        run[col] += diff[size_t(g[A]) * cols + col];
+        const int64_t inside = volume[i] + run[col] * bin_steps;
+        occupancy[i] = inside == full ? 1.0f : float(double(inside) * inv_full);  // exactly 1 when full
+      }
+    }
+  }
+}
+
+void resolve_volume(const VoxelSource& src, BlockScratch& s) {
   const int64_t bin_steps = int64_t(src.m) * int64_t(depth_steps_per_cell(src.world->chunk_size()));
   const int64_t n = s.full_n;
   const int64_t full = 4 * n * n * bin_steps;
-  const double inv_full = 1.0 / double(full);
-  for (int cv = 0; cv < d[v]; ++cv) {
-    for (int cu = 0; cu < d[u]; ++cu) {
-      const int64_t* diff = s.volume_diff.data() + size_t(cv * d[u] + cu) * size_t(d[a] + 1);
-      const size_t base = size_t(cu) * size_t(step[u]) + size_t(cv) * size_t(step[v]);
-      int64_t run = 0;
-      for (int b = 0; b < d[a]; ++b) {
-        run += diff[b];
-        const size_t i = base + size_t(b) * size_t(step[a]);
-        const int64_t inside = s.volume[i] + run * bin_steps;
-        s.occupancy[i] = inside == full ? 1.0f : float(double(inside) * inv_full);  // exactly 1 when full
-      }
-    }
+  switch (src.occ_axis) {
+    case 0: resolve_volume_along<0>(s, bin_steps, full); break;
+    case 1: resolve_volume_along<1>(s, bin_steps, full); break;
+    default: resolve_volume_along<2>(s, bin_steps, full); break;
   }
 }
 

@@ -249,6 +249,7 @@ Result<VoxelGrid> voxelize(const World& world, const VoxelConfig& config, const 
     BlockPair& sc = scratch.local();
     detail::voxelize_sources(p.land, objects, blocks[bi], options.faces, &sc, &counters.local());
     const detail::BlockScratch& b = sc.land;
+    if (b.uniform == ChunkKind::kEmpty) return;  // nothing to copy: the grid holds 0 there already
     const VoxelBox& bb = blocks[bi];
     for (int z = 0; z < bb.dims.z; ++z) {
       for (int y = 0; y < bb.dims.y; ++y) {

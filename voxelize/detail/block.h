@@ -43,7 +43,8 @@ struct BlockScratch {
   bool faces = false;
   int full_n = 1;                      // n = m / stride: ray intervals per voxel edge
   std::vector<int64_t> volume;         // per voxel: weighted inside steps
-  std::vector<int64_t> volume_diff;    // per column of the occupancy axis: (bins + 1) run starts/ends
+  std::vector<int64_t> volume_diff;    // (bins + 1) x columns of the occupancy axis, bin-major: run starts/ends
+  std::vector<int64_t> volume_run;     // per column: the running sum of volume_diff (resolve scratch)
   std::vector<int32_t> coverage_diff;  // per column of the current axis: (bins + 1)
   std::vector<uint8_t> surface;        // per voxel: holds a surface point
   std::vector<uint8_t> touched;        // per voxel: bit f set when face f holds a surface point
