@@ -105,6 +105,20 @@ RayPoints RayReader::next() {
   return {f.starts_inside(ray, points), points};
 }
 
+RayPoints RayReader::next_at(int ray) {
+  const RayFamily& f = family_;
+  if (!f.is_uniform() && f.first_.empty()) {
+    for (; ray_ < ray; ++ray_) {
+      const uint32_t code = f.ray_code(ray_);
+      first_ += code < RayFamily::kOnePoint ? 0u : code == RayFamily::kOnePoint ? 1u : f.several_[several_++];
+    }
+  } else if (!f.is_uniform()) {
+    first_ = f.first_[size_t(ray)];
+  }
+  ray_ = ray;
+  return next();
+}
+
 std::span<const PackedPoint> RayFamily::points(int ray) const {
   uint32_t count = 0;
   const uint32_t first = first_point(ray, std::span<uint32_t>(&count, 1));

@@ -254,6 +254,10 @@ class RayReader {
  public:
   explicit RayReader(const RayFamily& family) : family_(family) {}
   RayPoints next();
+  // Skips the rays before `ray` (each in constant time) and reads it: for
+  // walks that visit a subset of the rays in order. `ray` must not be before
+  // the next one.
+  RayPoints next_at(int ray);
 
  private:
   const RayFamily& family_;

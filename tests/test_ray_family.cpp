@@ -1,7 +1,7 @@
 // RayFamily's storage: a two-bit code per ray (empty outside, empty inside,
 // one point, several with a byte count beside), start bits only where they
 // disagree with the points, and the wide form (32-bit offsets) past 255
-// points on a ray.
+// points on a ray; RayReader reads it back in order.
 #include <gtest/gtest.h>
 
 #include <random>
@@ -67,6 +67,16 @@ void expect_reads_back(const RayFamily& f, const std::vector<Ray>& rays) {
     first += uint32_t(rays[r].points.size());
   }
   EXPECT_EQ(f.point_count(), first);
+  // In order, every ray (next) and every third one (next_at skips the rest).
+  for (int step : {1, 3}) {
+    RayReader reader(f);
+    for (size_t r = 0; r < rays.size(); r += size_t(step)) {
+      const RayPoints got = step == 1 ? reader.next() : reader.next_at(int(r));
+      ASSERT_EQ(got.starts_inside, rays[r].inside) << "ray " << r << ", step " << step;
+      ASSERT_EQ(got.points.data(), f.points(int(r)).data()) << "ray " << r << ", step " << step;
+      ASSERT_EQ(got.points.size(), rays[r].points.size()) << "ray " << r << ", step " << step;
+    }
+  }
 }
 
 TEST(RayFamily, MostlyEmptyRaysReadBackAtEveryChunkSize) {

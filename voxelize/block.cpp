@@ -189,9 +189,25 @@ class AxisPass {
     }
   }
 
+  // The rays of one chunk column, in ray order: each chunk's rays are read
+  // in order (RayReader), not located one by one (which sums offsets along
+  // the ray's row: a sixth of a coarse cascade level's time).
   void walk_rays(int64_t ru0, int64_t ru1, int64_t rv0, int64_t rv1) {
+    readers_.clear();
+    for (const ColumnChunk& cc : column_) {
+      if (cc.data) readers_.emplace_back(cc.data->axis[size_t(a_)]);
+    }
+    rays_.resize(column_.size());
     for (int64_t rv = align_up(rv0); rv <= rv1; rv += stride_) {
-      for (int64_t ru = align_up(ru0); ru <= ru1; ru += stride_) walk_ray(ru, rv);
+      for (int64_t ru = align_up(ru0); ru <= ru1; ru += stride_) {
+        const int ray = int((rv & (c_ - 1)) * c_ + (ru & (c_ - 1)));
+        size_t reader = 0;
+        for (size_t i = 0; i < column_.size(); ++i) {
+          rays_[i] = column_[i].data ? readers_[reader++].next_at(ray)
+                                     : RayPoints{column_[i].kind == ChunkKind::kSolid, {}};
+        }
+        walk_ray(ru, rv);
+      }
     }
   }
 
@@ -242,7 +258,6 @@ class AxisPass {
     const RayColumns rc = columns_of(ru, rv);
     if (rc.count == 0) return;
     if (counters_) ++counters_->rays;
-    const int ray = int((rv & (c_ - 1)) * c_ + (ru & (c_ - 1)));
     bool inside = false;
     int64_t span_start = 0;
     int last_covered = -1;
@@ -250,13 +265,8 @@ class AxisPass {
     for (size_t i = 0; i < column_.size(); ++i) {
       const int64_t seg = int64_t(cd0_ + int(i)) * kDepthSteps;
       const int64_t lo = std::max(seg, d0_), hi = std::min(seg + kDepthSteps, d1_);
-      const RayFamily* fam = column_[i].data ? &column_[i].data->axis[size_t(a_)] : nullptr;
-      bool state = column_[i].kind == ChunkKind::kSolid;
-      std::span<const PackedPoint> pts;
-      if (fam) {
-        pts = fam->points(ray);  // empty for a uniform family
-        state = fam->starts_inside(ray, pts);
-      }
+      const std::span<const PackedPoint> pts = rays_[i].points;  // empty for a uniform family
+      bool state = rays_[i].starts_inside;
       size_t k = 0;
       for (; k < pts.size() && seg + pts[k].depth < lo; ++k) state = pts[k].enters();
       if (state != inside) {  // the segment's state at lo (a new ray, or the block's first segment)
@@ -309,6 +319,8 @@ class AxisPass {
   bool volume_on_ = false, faces_on_ = false;
   int cd0_ = 0;
   std::vector<ColumnChunk> column_;
+  std::vector<RayReader> readers_;  // the mixed chunks' of the column walked
+  std::vector<RayPoints> rays_;     // the ray walked, per chunk of column_
   std::vector<std::pair<int64_t, int64_t>> runs_;
 };
 
