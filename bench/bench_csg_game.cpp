@@ -1,9 +1,10 @@
 // Per-frame edits on the default landscape (h = 0.2 m): a sphere dig of radius
 // 2 m, a box build and a paint stroke, timed alone and with the re-mesh of the
 // chunks they dirtied (ChunkedMesh::update), at 1 and 2 threads and chunk sizes
-// 16 and 32; then 1,000 random digs with time per edit and memory.
+// 16 and 32; then 1,000 random digs with time per edit and memory; then the
+// self-intersecting pairs of the chunk meshes per contour config.
 //
-// Usage: bench_csg_game [--quick | --dig [runs] [untangle]]
+// Usage: bench_csg_game [--quick | --dig [runs] [untangle] | --validity]
 //   --dig: only the 2 m sphere dig + re-mesh (C = 32, LiveConfig's contour
 //   config, or with ContourConfig::untangle on when `untangle` follows), median
 //   and p95 over `runs` (default 101) at 1 and 2 threads.
@@ -178,9 +179,91 @@ void dig_table(int runs, bool untangle) {
   }
 }
 
+// Self-intersections of the engine's chunk meshes (mesh_quality of the
+// assembled ChunkedMesh, exact predicates) per contour config: on the
+// landscape as built, after `edits` random digs and builds (the same sequence
+// for every config), and the 2 m dig + re-mesh's median time at 2 threads.
+struct EngineConfig {
+  const char* name;
+  ldc::ContourConfig config;
+};
+
+size_t dig_median_us(const ldc::World& w, const ldc::ContourConfig& config, int runs) {
+  tbb::global_control gc(tbb::global_control::max_allowed_parallelism, 2);
+  ldc::WorldEditor ed(w);
+  ldc::ChunkedMesh meshes(config);
+  if (!meshes.build(ed.world()).ok()) std::abort();
+  const GameEdit dig = game_edits(w).front();
+  std::vector<double> total;
+  for (int r = 0; r < runs; ++r) {
+    auto t0 = std::chrono::steady_clock::now();
+    ldc::EditReceipt receipt = ed.apply(dig.brush, dig.op).value();
+    (void)meshes.update(ed.world(), ed.take_dirty()).value();
+    total.push_back(std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
+    if (!ed.undo(receipt).ok()) std::abort();
+    (void)meshes.update(ed.world(), ed.take_dirty()).value();
+  }
+  std::sort(total.begin(), total.end());
+  return size_t(total[total.size() / 2]);
+}
+
+void validity_table(bool quick) {
+  const int edits = quick ? 60 : 300, runs = quick ? 11 : 31;
+  std::printf("\n## Self-intersections of engine chunk meshes (h = 0.2 m, C = 32)\n\n");
+  std::printf("mesh_quality of ChunkedMesh::assemble() (exact predicates; the tools' `closed` = no pair, no "
+              "non-manifold edge or vertex, watertight): the default landscape as built, then after %d random edits "
+              "(spheres, noisy spheres and boxes in turn, radius or half-size 0.35 to 2 m, every 4th a build, the rest digs; "
+              "same sequence for every config), each "
+              "followed by ChunkedMesh::update; `dig ms` = the 2 m sphere dig + re-mesh, median of %d, 2 threads.\n\n",
+              edits, runs);
+  const std::vector<EngineConfig> configs = {
+      {"iterative, relax 4, untangle off (LiveConfig's default)", {.untangle = false}},
+      {"iterative, relax 4, untangle on", {.untangle = true}},
+      {"iterative, relax 0, untangle on", {.relax_iterations = 0, .untangle = true}},
+      {"mass points, relax 0", {.placement = ldc::Placement::kMassPoint, .relax_iterations = 0}},
+      {"mass points, relax 4", {.placement = ldc::Placement::kMassPoint}},
+      {"mass points, relax 4 without the pull back to the planes",
+       {.placement = ldc::Placement::kMassPoint, .relax_plane_pull = 0.0}},
+  };
+  std::printf("| config | triangles | pairs | non-manifold edges + vertices | closed | triangles after | pairs after | "
+              "closed after | dig ms |\n|---|---|---|---|---|---|---|---|---|\n");
+  const ldc::World w = ldc::build_terrain({}, 0.2, 32).value();
+  for (const EngineConfig& c : configs) {
+    ldc::WorldEditor ed(w);
+    ldc::ChunkedMesh meshes(c.config);
+    if (!meshes.build(ed.world()).ok()) std::abort();
+    const ldc::ContourMesh m0 = meshes.assemble();
+    const ldc::MeshQuality q0 = ldc::mesh_quality(m0);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> xy(2.0, 46.0), radius(0.5, 2.0), dz(-1.5, 1.0);
+    for (int i = 0; i < edits; ++i) {
+      const double x = xy(rng), y = xy(rng);
+      const glm::dvec3 at(x, y, ground_height(ed.world(), x, y) + dz(rng));
+      const double r = radius(rng);
+      // Spheres, noisy spheres and boxes (sharp edges); every 4th edit builds, the rest dig.
+      const ldc::Brush b = i % 3 == 0   ? ldc::Brush::sphere(at, r)
+                           : i % 3 == 1 ? ldc::Brush::noisy_sphere(at, {.radius = r})
+                                        : ldc::Brush::box(at, glm::dvec3(0.7 * r), uint16_t(1 + i % 3));
+      if (!ed.apply(b, i % 4 == 3 ? ldc::EditOp::kUnion : ldc::EditOp::kSubtract).ok()) std::abort();
+      if (!meshes.update(ed.world(), ed.take_dirty()).ok()) std::abort();
+    }
+    const ldc::ContourMesh m1 = meshes.assemble();
+    const ldc::MeshQuality q1 = ldc::mesh_quality(m1);
+    std::printf("| %s | %zu | %zu | %zu | %s | %zu | %zu | %s | %.2f |\n", c.name, m0.triangles.size(),
+                q0.self_intersecting_pairs, q0.nonmanifold_edges + q0.nonmanifold_vertices, q0.closed() ? "yes" : "no",
+                m1.triangles.size(), q1.self_intersecting_pairs, q1.closed() ? "yes" : "no",
+                double(dig_median_us(w, c.config, runs)) / 1000.0);
+    std::fflush(stdout);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc > 1 && std::strcmp(argv[1], "--validity") == 0) {
+    validity_table(false);
+    return 0;
+  }
   if (argc > 1 && std::strcmp(argv[1], "--dig") == 0) {
     const bool untangle = argc > 3 && std::strcmp(argv[3], "untangle") == 0;
     dig_table(argc > 2 ? std::max(1, std::atoi(argv[2])) : 101, untangle);
@@ -191,5 +274,6 @@ int main(int argc, char** argv) {
   ldc::bench::print_machine();
   game_table(quick);
   stress_table(quick);
+  validity_table(quick);
   return 0;
 }
