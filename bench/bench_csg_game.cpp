@@ -212,9 +212,9 @@ void validity_table(bool quick) {
   std::printf("\n## Self-intersections of engine chunk meshes (h = 0.2 m, C = 32)\n\n");
   std::printf("mesh_quality of ChunkedMesh::assemble() (exact predicates; the tools' `closed` = no pair, no "
               "non-manifold edge or vertex, watertight): the default landscape as built, then after %d random edits "
-              "(spheres, noisy spheres and boxes in turn, radius or half-size 0.35 to 2 m, every 4th a build, the rest digs; "
-              "same sequence for every config), each "
-              "followed by ChunkedMesh::update; `dig ms` = the 2 m sphere dig + re-mesh, median of %d, 2 threads.\n\n",
+              "(spheres, noisy spheres and boxes in turn, radius or half-size 0.35 to 2 m, every 4th a build, the "
+              "rest digs; same sequence for every config), each followed by ChunkedMesh::update; `dig ms` = the 2 m "
+              "sphere dig + re-mesh, median of %d, 2 threads.\n\n",
               edits, runs);
   const std::vector<EngineConfig> configs = {
       {"iterative, relax 4, untangle off (LiveConfig's default)", {.untangle = false}},

@@ -106,6 +106,7 @@ RayPoints RayReader::next() {
 }
 
 RayPoints RayReader::next_at(int ray) {
+  assert(ray >= ray_);
   const RayFamily& f = family_;
   if (!f.is_uniform() && f.first_.empty()) {
     for (; ray_ < ray; ++ray_) {
