@@ -265,19 +265,26 @@ static void propagate_packed(PackedGBuffer* tex, const LevelArrays& arrays, int 
       const glm::ivec3 g0 = region.lo + glm::ivec3(0, y, z);
       const int ty = wrap(g0.y, n), tz = wrap(g0.z, n);
       const size_t occ_row = local_index({0, ty, tz}, n);
-      for (int x = 0; x < region.dims.x; ++x) {
+      // Tile coordinates step with the voxel and wrap by comparison: no
+      // division per voxel or neighbour (floor_mod took about 5% of a level-0
+      // update in a profile; the update is 2-3% faster without it).
+      int tx = wrap(g0.x, n);
+      for (int x = 0; x < region.dims.x; ++x, tx = tx + 1 == n ? 0 : tx + 1) {
         const glm::ivec3 g = g0 + glm::ivec3(x, 0, 0);
-        const int tx = wrap(g.x, n);
         const size_t v = occ_row + size_t(tx);
         const bool solid = occ[v] > 0.0f;
         if (!solid && prop[v] == 0) continue;
         uint8_t want = 0;
         std::array<size_t, kFaces> from{};
         if (solid) {
+          const glm::ivec3 t(tx, ty, tz);
           for (int f = 0; f < kFaces; ++f) {
-            const glm::ivec3 nb = g + face_direction(f);
-            if ((own[v] >> f) & 1u || !box.contains(nb)) continue;
-            const size_t w = local_index(wrap(nb, n), n);
+            const glm::ivec3 d = face_direction(f);
+            if ((own[v] >> f) & 1u || !box.contains(g + d)) continue;
+            glm::ivec3 tn = t + d;
+            const int a = face_axis(f);
+            tn[a] = tn[a] == n ? 0 : tn[a] < 0 ? n - 1 : tn[a];
+            const size_t w = local_index(tn, n);
             if ((own[w] >> f) & 1u) want = uint8_t(want | (1u << f)), from[size_t(f)] = w;
           }
         }
