@@ -2,6 +2,8 @@
 # with both engines, from .gpu/bundle.tgz (scripts/gpu-bundle.sh), on a machine
 # with an NVIDIA driver (its Vulkan ICD under /usr/local/nvidia) and the
 # libvulkan1/libglvnd .deb files in .gl/. Outputs go to $OUT.
+# GPU_GI_IMAGES=PATHS also runs issue 25's whole-image benchmark
+# (`bench_gi 0 PATHS images`, both engines against the path tracer) last.
 set -u
 cd "$(dirname "$0")/.."
 OUT=${OUT:-out/gpu}; mkdir -p "$OUT"
@@ -19,3 +21,7 @@ echo "== bench_gi timing"; timeout 200 $B/bin/bench_gi 0 0 timing 2>&1 | tee $OU
 echo "== main job gi"; mkdir -p out
 $B/bin/ldc terrain -o out/default.ldc >/dev/null && $B/bin/ldc edit out/default.ldc --script scripts/default-tunnel.json -o out/tunnel.ldc >/dev/null
 for e in vulkan cpu; do timeout 60 $B/bin/ldc gi out/tunnel.ldc -o $OUT/tunnel-gi-$e.png --camera 61,-5,10 --target 45,11,3.4 --fov 55 --width 480 --height 270 --engine $e --passes 8 2>&1 | tee -a $OUT/ldc_gi.txt; done
+if [ -n "${GPU_GI_IMAGES:-}" ]; then
+  echo "== bench_gi images ($GPU_GI_IMAGES paths per pixel)"
+  timeout 300 $B/bin/bench_gi 0 "$GPU_GI_IMAGES" images 2>&1 | tee $OUT/bench_gi_images.txt
+fi
