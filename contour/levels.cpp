@@ -740,9 +740,10 @@ struct PolygonVertex {
   const LevelVertex* v;
 };
 
-// Triangles of a quad around an edge 2^edge_level long: the diagonal whose
-// midpoint fits the Hermite planes of its two end cells best (ties: the
-// shorter), as the uniform mesher does, except across two cells both wider
+// Triangles of a quad around an edge 2^e.level long: the uniform mesher's
+// rule (detail::split_along_02: a diagonal that folds no triangle over, then
+// the one whose midpoint fits the Hermite planes of its two end cells best,
+// then the shorter), except across two cells both wider
 // than the edge. Those meet along a line cut into several edges (a coarse
 // line beside a finer chunk), and the quads of the next edges on it have
 // the same two cells as opposite corners: where two such edges cross, one
@@ -750,14 +751,17 @@ struct PolygonVertex {
 // turned boxes' union, a sheet of the third cell looping over those two
 // edges alone). The other diagonal holds a cell as wide as the edge (the
 // finest chunk around the line has one there), so it lies in this quad only.
-bool split_along_02(const PolygonVertex p[4], int edge_level) {
+bool split_along_02(const PolygonVertex p[4], const OwnedEdge& e) {
+  const int edge_level = e.level;
   auto wider = [&](int i) { return p[i].v->level > edge_level; };
   if (wider(0) && wider(2)) return false;
   if (wider(1) && wider(3)) return true;
   const glm::dvec3 m02 = 0.5 * (p[0].v->x + p[2].v->x), m13 = 0.5 * (p[1].v->x + p[3].v->x);
   auto err = [&](int i, const glm::dvec3& m) { return p[i].v->qef.error(m - glm::dvec3(p[i].v->cell_lo)); };
   const glm::dvec3 corners[4] = {p[0].v->x, p[1].v->x, p[2].v->x, p[3].v->x};
-  return detail::split_along_02(err(0, m02) + err(2, m02), err(1, m13) + err(3, m13), corners);
+  glm::dvec3 facing(0.0);
+  facing[e.axis] = e.lower_inside ? 1.0 : -1.0;
+  return detail::split_along_02(err(0, m02) + err(2, m02), err(1, m13) + err(3, m13), corners, facing);
 }
 
 // The triangles of one crossing edge, its cells' vertices found by
@@ -779,7 +783,7 @@ bool emit_polygon(const OwnedEdge& e, Lookup&& lookup, std::vector<glm::uvec3>& 
   if (n == 3) {
     tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
     mats.push_back(e.material);
-  } else if (split_along_02(ring, e.level)) {
+  } else if (split_along_02(ring, e)) {
     tris.emplace_back(ring[0].index, ring[1].index, ring[2].index);
     tris.emplace_back(ring[0].index, ring[2].index, ring[3].index);
     mats.insert(mats.end(), 2, e.material);

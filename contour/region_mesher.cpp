@@ -82,9 +82,13 @@ void RegionMesher::split(const Quad& q, int tri[2][3]) const {
     v[i] = vertex(q.cell[i], q.sheet[i]);
     p[i] = glm::dvec3(q.cell[i] - frame) + v[i]->x;
   }
+  // The cells' centres go round the edge as the corners do: half their
+  // diagonals' cross product is the edge's unit axis, outwards.
+  const glm::dvec3 facing =
+      0.5 * glm::cross(glm::dvec3(q.cell[2] - q.cell[0]), glm::dvec3(q.cell[3] - q.cell[1]));
   glm::dvec3 m02 = 0.5 * (p[0] + p[2]), m13 = 0.5 * (p[1] + p[3]);
   auto err = [&](int i, const glm::dvec3& m) { return v[i]->qef.error(m - glm::dvec3(q.cell[i] - frame)); };
-  const bool use02 = split_along_02(err(0, m02) + err(2, m02), err(1, m13) + err(3, m13), p);
+  const bool use02 = split_along_02(err(0, m02) + err(2, m02), err(1, m13) + err(3, m13), p, facing);
   static const int kDiag02[2][3] = {{0, 1, 2}, {0, 2, 3}};
   static const int kDiag13[2][3] = {{0, 1, 3}, {1, 2, 3}};
   const int(*t)[3] = use02 ? kDiag02 : kDiag13;

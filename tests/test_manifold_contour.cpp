@@ -15,6 +15,7 @@
 
 #include "contour/contour.h"
 #include "contour/detail/cell_sheets.h"
+#include "contour/detail/placement.h"
 #include "csg/csg.h"
 #include "ldc/build.h"
 #include "ldc/terrain.h"
@@ -213,6 +214,42 @@ TEST(ManifoldContour, ThinSlabAndTouchingBoxesAreClosedManifolds) {
   }
 }
 
+// Relaxation pulled corner 3 of a quad round a z edge towards the edge,
+// making the quad concave there: the diagonal 0-2 would turn triangle 0-2-3
+// over, so 1-3 is taken although the planes prefer 0-2 (e02 < e13).
+TEST(QuadSplit, TakesTheDiagonalThatDoesNotFold) {
+  const glm::dvec3 up(0.0, 0.0, 1.0);  // the edge from (1, 1, 0) along z, inside below
+  const glm::dvec3 concave[4] = {{0.1, 0.9, 0.5}, {1.5, 0.5, 0.5}, {1.1, 1.9, 0.5}, {0.95, 1.05, 0.5}};
+  EXPECT_FALSE(detail::split_along_02(0.0, 1.0, concave, up));
+  // Convex: the planes decide, either way.
+  const glm::dvec3 convex[4] = {{0.5, 0.5, 0.5}, {1.5, 0.5, 0.5}, {1.5, 1.5, 0.5}, {0.5, 1.5, 0.5}};
+  EXPECT_TRUE(detail::split_along_02(0.0, 1.0, convex, up));
+  EXPECT_FALSE(detail::split_along_02(1.0, 0.0, convex, up));
+}
+
+// Any vertex in each of the four cells round the edge: the quad is
+// star-shaped about the edge, so some diagonal gives two triangles facing
+// out, and the rule takes one that does, whatever the planes say.
+TEST(QuadSplit, NeverFoldsAQuadWithOneVertexInEachCellRoundItsEdge) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const glm::dvec2 cell[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // counter-clockwise seen from +z
+  auto area = [](const glm::dvec3& a, const glm::dvec3& b, const glm::dvec3& c) { return glm::cross(b - a, c - a).z; };
+  int concave = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    glm::dvec3 p[4];
+    for (int k = 0; k < 4; ++k) p[k] = glm::dvec3(cell[k].x + u(rng), cell[k].y + u(rng), u(rng));
+    const bool use02 = detail::split_along_02(u(rng), u(rng), p, {0.0, 0.0, 1.0});
+    const double a = use02 ? std::min(area(p[0], p[1], p[2]), area(p[0], p[2], p[3]))
+                           : std::min(area(p[0], p[1], p[3]), area(p[1], p[2], p[3]));
+    const double other = use02 ? std::min(area(p[0], p[1], p[3]), area(p[1], p[2], p[3]))
+                               : std::min(area(p[0], p[1], p[2]), area(p[0], p[2], p[3]));
+    concave += other <= 0.0;
+    EXPECT_GT(a, 0.0) << "trial " << trial;
+  }
+  EXPECT_GT(concave, 1000);  // the case occurs: 1,880 of the 20,000 quads
+}
+
 TEST(ManifoldContour, TestMeshesComeOutClosedAt64Cells) {
   for (const char* name : {"spot.obj", "fandisk.obj", "rocker-arm.obj", "stanford-bunny.obj"}) {
     World w = build_from_mesh(test::load_test_mesh(name), {.cells = 64}).value();
@@ -220,10 +257,12 @@ TEST(ManifoldContour, TestMeshesComeOutClosedAt64Cells) {
     ContourMesh m = contour_world(w, {}, nullptr, &stats).value();
     expect_closed_manifold(m, name);
     const MeshQuality q = mesh_quality(m);
+    EXPECT_EQ(q.self_intersecting_pairs, 0u) << name;
+    // Without the local round: at most a few pairs (measured 0, 0, 3, 10),
+    // each cleared by moving a few vertices (measured 0 to 33 of 7,000 to 12,000).
     ContourMesh tangled = contour_world(w, {.untangle = false}).value();
-    EXPECT_GT(mesh_quality(tangled).self_intersecting_pairs, 5 * q.self_intersecting_pairs) << name;
-    EXPECT_GT(stats.untangled_vertices, 0u) << name;
-    EXPECT_LT(stats.untangled_vertices, q.vertices / 8) << name;
+    EXPECT_LE(mesh_quality(tangled).self_intersecting_pairs, 20u) << name;
+    EXPECT_LT(stats.untangled_vertices, q.vertices / 100) << name;
   }
 }
 
@@ -238,8 +277,9 @@ TEST(Untangle, KeepsTheCornersOfRotatedBoxes) {
     const double h = w.lattice().cell_size;
     ContourMesh untangled = contour_world(w, {.cell_slack = 1.0}).value();
     ContourMesh tangled = contour_world(w, {.cell_slack = 1.0, .untangle = false}).value();
-    EXPECT_LT(mesh_quality(untangled).self_intersecting_pairs, mesh_quality(tangled).self_intersecting_pairs / 10)
-        << "box " << i;
+    const size_t tangled_pairs = mesh_quality(tangled).self_intersecting_pairs;
+    EXPECT_GT(tangled_pairs, 0u) << "box " << i;  // slack 1 folds a few (measured 21, 54, 28)
+    EXPECT_LT(3 * mesh_quality(untangled).self_intersecting_pairs, tangled_pairs) << "box " << i;
     for (int k = 0; k < 8; ++k) {
       const glm::dvec3 corner(m * glm::dvec4((k & 1) ? 1 : -1, (k & 2) ? 1 : -1, (k & 4) ? 1 : -1, 1.0));
       double nearest = INFINITY;
