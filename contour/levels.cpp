@@ -531,7 +531,12 @@ class ChunkMesher {
     if (any_joined) trace_sheets(shape_, joined);
     ++out.cells;
     const uint32_t first = uint32_t(out.vertices.size());
+    sheet_mass_.resize(size_t(shape_.sheets));
     for (int sheet = 0; sheet < shape_.sheets; ++sheet) out.vertices.push_back(place(sheet));
+    for (int sheet = 0; shape_.sheets > 1 && sheet < shape_.sheets; ++sheet) {
+      glm::dvec3& x = out.vertices[first + uint32_t(sheet)].x;
+      x = detail::keep_to_own_sheet(x, sheet, sheet_mass_.data(), shape_.sheets);
+    }
     record_edges(first, emit_edges, out);
   }
 
@@ -695,6 +700,7 @@ class ChunkMesher {
     LevelVertex v;
     const Qef unit_qef = Qef::of(unit_planes);
     v.x = glm::dvec3(cell.lo) + s * detail::place_vertex(unit_planes, unit_qef, glm::dvec3(0.0), *config_).position;
+    sheet_mass_[size_t(sheet)] = glm::dvec3(cell.lo) + s * unit_planes.mass_point();
     v.normal = planes.mean_normal();
     v.material = planes.majority_material();
     v.cell_lo = cell.lo;
@@ -731,6 +737,7 @@ class ChunkMesher {
   std::vector<uint8_t> no_joins_, joined_;
   std::vector<int> segments_;
   std::vector<const CellCrossing*> on_loop_;
+  std::vector<glm::dvec3> sheet_mass_;  // place(): each sheet's mass point, level-0 lattice coordinates
 };
 
 // --- Polygons and assembly -----------------------------------------------------

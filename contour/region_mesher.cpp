@@ -164,8 +164,19 @@ void RegionMesher::place_vertices(const glm::ivec3& used_lo, const glm::ivec3& u
         cell_vertex_[i] = int32_t(verts_.size());
         cell_sheet_key_[i] = uint16_t(corners | joined << 8);
         for (int s = 0; s < sheets.count; ++s) add_vertex(cell, s, planes[s]);
+        if (sheets.count > 1) keep_sheets_apart(verts_.size() - size_t(sheets.count), sheets.count);
       }
     }
+  }
+}
+
+// The vertices of one cell's sheets, verts_[first, first + count): each on its own side (keep_to_own_sheet).
+void RegionMesher::keep_sheets_apart(size_t first, int count) {
+  glm::dvec3 mass[CellSheets::kMaxSheets];
+  for (int s = 0; s < count; ++s) mass[s] = verts_[first + size_t(s)].mass;
+  for (int s = 0; s < count; ++s) {
+    CellVertex& v = verts_[first + size_t(s)];
+    v.x = keep_to_own_sheet(v.x, s, mass, count);
   }
 }
 

