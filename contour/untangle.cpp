@@ -11,9 +11,9 @@
 // independent directions), which stay where the features meet: moving them
 // loses the corner and, on the shared meshes, clears no more intersections.
 // Sharp features survive everywhere else. On the shared meshes at 256 cells
-// this clears every pair the quad split rule (detail::split_along_02)
-// leaves (fandisk 21 -> 0, spot 11 -> 0, bunny 376 -> 0, rocker-arm 2 -> 0),
-// moving 0.01 to 0.2% of the vertices.
+// this clears every pair that the quad split rule (detail::split_along_02)
+// and keep_to_own_sheet leave (fandisk 21 -> 0, spot 11 -> 0, bunny 23 -> 0,
+// rocker-arm 2 -> 0), moving 0.01 to 0.1% of the vertices.
 //
 // Locality: a triangle lies in the 2 x 2 x 1 cells around its edge (grown
 // by cell_slack), so two triangles that meet have edge nodes at most

@@ -69,17 +69,17 @@ struct LiveConfig {
   bool meshes = false;
   // Chunk meshes are watertight 2-manifolds (no boundary, no non-manifold
   // edge or vertex), placed for sharp features with relaxed material borders,
-  // but not free of self-intersecting triangle pairs: 726 on the default
-  // landscape (472,032 triangles), 3,787 after 300 random edits (594,164;
+  // but not free of self-intersecting triangle pairs: 29 on the default
+  // landscape (472,032 triangles), 401 after 300 random edits (594,164;
   // bench_csg_game --validity, docs/live.md). A render mesh or a physics
   // triangle collider does not mind them; a convex decomposition, a slicer
   // or another boolean does. For those:
   // - {.placement = Placement::kMassPoint, .relax_iterations = 0} measured no
   //   pair at all, and re-meshes a 2 m dig 2.3 times faster, but keeps no
   //   sharp edge and no relaxed material border (fandisk at 256 cells: normal
-  //   error near sharp edges 8.1 degrees against 1.3);
-  // - untangle = true keeps both and clears 97-98% of the pairs (17 and 113
-  //   are left), at 4 times the re-mesh time;
+  //   error near sharp edges 8.1 degrees against 0.22);
+  // - untangle = true keeps both and clears 83 and 95% of the pairs (5 and
+  //   21 are left), at 4 times the re-mesh time;
   // - or run untangle_mesh on assemble()'s mesh before it leaves the game.
   ContourConfig contour{.untangle = false};
   // Chunk meshes at levels of detail by distance to the camera
