@@ -616,10 +616,10 @@ Result<SimplifyStats> simplify_mesh(ContourMesh& mesh, const SimplifyOptions& op
 // --- Untangling the assembled mesh ------------------------------------------------
 //
 // Sharp-feature placement folds a few of a uniform mesh's triangles through
-// their neighbours (up to 0.05% on the shared meshes at 256 cells). ContourConfig::untangle clears most of these
-// while contouring (one local round at the mass points), but not all (tiny
-// blobs around a lattice node, saddles, two sheets in one cell), and blunts
-// features. untangle_mesh clears them on a whole mesh (contoured with or
+// their neighbours (fandisk at 256 cells: 21 pairs in 159,940 triangles).
+// ContourConfig::untangle clears most of these while contouring (one local
+// round at the mass points), but not all (tiny blobs around a lattice node,
+// saddles, two sheets in one cell), and blunts features. untangle_mesh clears them on a whole mesh (contoured with or
 // without that round, simplified, or any triangle mesh): the
 // vertices of every intersecting triangle pair move to the centroid of their
 // neighbours, a move that would turn a triangle over is halved or undone,

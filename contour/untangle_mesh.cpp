@@ -1,8 +1,8 @@
 // untangle_mesh: clears self-intersections on a whole mesh.
 //
 // Dual contouring's placement for sharp features folds a few triangles
-// through their neighbours: up to 0.05% of a uniform mesh's triangles at 256
-// cells on the shared meshes (the tools contour without the local mass-point round of
+// through their neighbours (fandisk at 256 cells: 21 pairs in 159,940
+// triangles; the tools contour without the local mass-point round of
 // untangle.cpp and come here instead), or, after that round, what it leaves:
 // tiny blobs around single lattice nodes, saddles, two sheets in one cell.
 // Each is a crease of a few triangles folded through a neighbour.
