@@ -533,9 +533,11 @@ class ChunkMesher {
     const uint32_t first = uint32_t(out.vertices.size());
     sheet_mass_.resize(size_t(shape_.sheets));
     for (int sheet = 0; sheet < shape_.sheets; ++sheet) out.vertices.push_back(place(sheet));
-    for (int sheet = 0; shape_.sheets > 1 && sheet < shape_.sheets; ++sheet) {
-      glm::dvec3& x = out.vertices[first + uint32_t(sheet)].x;
-      x = detail::keep_to_own_sheet(x, sheet, sheet_mass_.data(), shape_.sheets);
+    if (shape_.sheets > 1) {
+      for (int sheet = 0; sheet < shape_.sheets; ++sheet) {
+        glm::dvec3& x = out.vertices[first + uint32_t(sheet)].x;
+        x = detail::keep_to_own_sheet(x, sheet, sheet_mass_.data(), shape_.sheets);
+      }
     }
     record_edges(first, emit_edges, out);
   }

@@ -347,7 +347,8 @@ void expect_closed(const ContourMesh& m, const std::string& name) {
 // that does not fold and sheets sharing a cell keep apart; without the local
 // untangling round, and placed by the QEF alone, more is left, so the
 // untangle_mesh tests run all three.
-const ContourConfig kTangledConfigs[] = {{}, {.untangle = false}, {.placement = Placement::kQef, .untangle = false}};
+const ContourConfig kQefWithoutTheRound{.placement = Placement::kQef, .untangle = false};
+const ContourConfig kTangledConfigs[] = {{}, {.untangle = false}, kQefWithoutTheRound};
 
 TEST(UntangleMesh, ClearsEveryCornerConfigurationOfACell) {
   std::mt19937 rng(7);
@@ -577,7 +578,7 @@ ContourMesh uniform_edited_landscape() {
                                 glm::normalize(glm::dvec3(-0.9371973276954111, -0.5064789022136653, 0.4277349478706338))) *
                     glm::translate(glm::dmat4(1.0), -centre) * box.transform();
   EXPECT_TRUE(editor.apply(box, EditOp::kSubtract).ok());
-  return contour_world(editor.world(), {.placement = Placement::kQef, .untangle = false}).value();  // see kTangledConfigs
+  return contour_world(editor.world(), kQefWithoutTheRound).value();  // see kTangledConfigs
 }
 
 ContourMesh simplified_edited_landscape() {
@@ -658,7 +659,7 @@ TEST(UntangleMesh, PairsLeftEqualAFullSearch) {
     for (int z = 1; z < 5; ++z)
       for (int y = 1; y < 5; ++y)
         for (int x = 1; x < 5; ++x) values[size_t((z * 6 + y) * 6 + x)] = value(rng);
-    ContourMesh m = contour_world(field_world(6, values), kTangledConfigs[2]).value();
+    ContourMesh m = contour_world(field_world(6, values), kQefWithoutTheRound).value();
     for (int rounds : {1, 2, 50}) {
       ContourMesh copy = m;
       const UntangleMeshStats stats = untangle_mesh(copy, {.max_rounds = rounds}).value();
