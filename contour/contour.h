@@ -98,8 +98,12 @@ struct ContourConfig {
   // which is off the surface: with 0, vertices next to features that cross a
   // cell border sit up to about a third of a cell off; with 1, rotated boxes
   // come out with every vertex within 0.001 h of a face and every corner kept
-  // (tests/test_contour.cpp measures both). More slack lets neighbouring
-  // triangles fold over more easily.
+  // (tests/test_contour.cpp measures both). A vertex whose planes meet
+  // round the far side of the solid corners its sheet wraps stays in its
+  // cell, however much slack (that would turn its surface inside out). More
+  // slack lets neighbouring triangles fold over more easily; untangle_mesh
+  // does not always clear what slack 1 folds (random blocks of 3^3 cells
+  // keep up to 19 pairs), and the quality report then says so.
   double cell_slack = 0.0;
   // Material-border relaxation: vertices whose quads have different
   // materials move `relax_iterations` times by `relax_strength` towards the
