@@ -696,12 +696,12 @@ class ChunkMesher {
       const CellCrossing& c = *on_loop[i * n / kept];
       glm::dvec3 p = glm::dvec3(c.lower - cell.lo);
       p[c.axis] += double(c.x->t) * double(1 << c.level);
-      unit_planes.add(p / s, glm::dvec3(c.x->normal), c.x->material);
-      planes.add(p, glm::dvec3(c.x->normal), c.x->material);
+      unit_planes.add(p / s, glm::dvec3(c.x->normal), c.x->material, c.axis);
+      planes.add(p, glm::dvec3(c.x->normal), c.x->material, c.axis);
     }
     LevelVertex v;
     const Qef unit_qef = Qef::of(unit_planes);
-    v.x = glm::dvec3(cell.lo) + s * detail::place_vertex(unit_planes, unit_qef, glm::dvec3(0.0), *config_).position;
+    v.x = glm::dvec3(cell.lo) + s * detail::place_vertex(unit_planes, unit_qef, *config_).position;
     sheet_mass_[size_t(sheet)] = glm::dvec3(cell.lo) + s * unit_planes.mass_point();
     v.normal = planes.mean_normal();
     v.material = planes.majority_material();

@@ -294,52 +294,33 @@ PlacedVertex place_in_box(const CellPlanes& planes, const Qef& qef, const glm::d
   return out;
 }
 
-// Each crossing's edge, from its inside end to its outside end (the normal
-// points to the outside end), in cell coordinates.
-struct CrossedEdge {
-  glm::dvec3 inside_end{0.0}, outward{0.0};
-};
-
-CrossedEdge crossed_edge(const CellPlanes& planes, int i, const glm::dvec3& cell_min) {
-  CrossedEdge e;
-  e.inside_end = planes.point[i] - cell_min;
-  for (int a = 0; a < 3; ++a) {
-    if (e.inside_end[a] == 0.0 || e.inside_end[a] == 1.0) continue;  // not the edge's axis
-    const bool plus = planes.normal[i][a] > 0.0;
-    e.inside_end[a] = plus ? 0.0 : 1.0;
-    e.outward[a] = plus ? 1.0 : -1.0;
-  }
-  return e;
-}
-
-// Whether x lies behind the inside end of every one of the sheet's crossed
-// edges, seen along the sum of those edges' outward directions: gone round
-// to the far side of the solid corners the sheet wraps, which turns its part
-// of the surface inside out. A vertex in its cell never is. With cell_slack,
-// the planes of a sheet round a lone inside corner (normals tilted by the
-// neighbouring nodes) can meet there: the corner configuration of a cell
-// with four lone corners came out as a closed surface of negative volume,
-// with nothing intersecting. A rotated box's corners, which slack is for,
-// lie ahead of the inside ends (tests/test_contour.cpp keeps them).
-bool behind_an_inside_end(const CellPlanes& planes, const glm::dvec3& x, const glm::dvec3& cell_min) {
-  glm::dvec3 outward(0.0);
-  for (int i = 0; i < planes.count; ++i) outward += crossed_edge(planes, i, cell_min).outward;
-  for (int i = 0; i < planes.count; ++i) {
-    if (glm::dot(outward, x - cell_min - crossed_edge(planes, i, cell_min).inside_end) >= 0.0) return false;
-  }
-  return planes.count > 0;
-}
-
 }  // namespace
 
-PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::dvec3& cell_min,
-                          const ContourConfig& config) {
-  const glm::dvec3 lo = cell_min - config.cell_slack, hi = cell_min + 1.0 + config.cell_slack;
-  PlacedVertex out = place_in_box(planes, qef, lo, hi, config);
-  const bool left_the_cell = glm::any(glm::lessThan(out.position, cell_min)) ||
-                             glm::any(glm::greaterThan(out.position, cell_min + 1.0));
-  if (left_the_cell && behind_an_inside_end(planes, out.position, cell_min)) {  // then no slack
-    out = place_in_box(planes, qef, cell_min, cell_min + 1.0, config);
+FarSide far_side(const CellPlanes& planes) {
+  FarSide f;
+  glm::dvec3 inside_end[12];
+  for (int i = 0; i < planes.count; ++i) {
+    const int a = planes.axis[i];
+    const bool plus = planes.normal[i][a] > 0.0;  // the normal points to the outside end
+    inside_end[i] = planes.point[i];
+    inside_end[i][a] = plus ? 0.0 : 1.0;
+    f.outward[a] += plus ? 1.0 : -1.0;
+  }
+  double nearest = INFINITY;
+  for (int i = 0; i < planes.count; ++i) nearest = std::min(nearest, glm::dot(f.outward, inside_end[i]));
+  if (planes.count > 0) f.nearest = nearest;
+  return f;
+}
+
+bool left_the_cell(const glm::dvec3& x) {
+  return glm::any(glm::lessThan(x, glm::dvec3(0.0))) || glm::any(glm::greaterThan(x, glm::dvec3(1.0)));
+}
+
+PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const ContourConfig& config) {
+  const double slack = config.cell_slack;
+  PlacedVertex out = place_in_box(planes, qef, glm::dvec3(-slack), glm::dvec3(1.0 + slack), config);
+  if (left_the_cell(out.position) && far_side(planes).holds(out.position)) {  // then no slack
+    out = place_in_box(planes, qef, glm::dvec3(0.0), glm::dvec3(1.0), config);
     out.clamped = true;
   }
   return out;

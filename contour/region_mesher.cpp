@@ -127,7 +127,7 @@ CellPlanes RegionMesher::planes_of(const glm::ivec3& cell, const CellSheets& she
       p[axis_u(a)] += k & 1;
       p[axis_v(a)] += (k >> 1) & 1;
       p[a] += edges[k]->t;
-      planes.add(p, glm::dvec3(edges[k]->normal), edges[k]->material);
+      planes.add(p, glm::dvec3(edges[k]->normal), edges[k]->material, a);
     }
   }
   return planes;
@@ -201,7 +201,7 @@ void RegionMesher::add_vertex(const glm::ivec3& cell, int sheet, const CellPlane
   v.sheet = uint8_t(sheet);
   v.qef = Qef::of(planes);
   v.mass = planes.mass_point();
-  PlacedVertex pv = place_vertex(planes, v.qef, glm::dvec3(0.0), config_);
+  PlacedVertex pv = place_vertex(planes, v.qef, config_);
   v.x = pv.position;
   v.material = planes.majority_material();
   v.normal = planes.mean_normal();
@@ -269,7 +269,11 @@ glm::dvec3 RegionMesher::relaxed_position(size_t b) const {
   for (int it = 0; it < 8 && planes > 0.0; ++it) {
     p += config_.relax_plane_pull * (v.qef.b - v.qef.times(p)) / planes;  // sum_i n_i (n_i . (p_i - x)) / N
   }
-  return clamp_to_cell(p, glm::dvec3(0.0), config_.cell_slack, nullptr);
+  p = clamp_to_cell(p, glm::dvec3(0.0), config_.cell_slack, nullptr);
+  if (left_the_cell(p) && far_side(planes_of(v.cell, sheets_of(v.cell), v.sheet)).holds(p)) {  // see FarSide
+    p = clamp_to_cell(p, glm::dvec3(0.0), 0.0, nullptr);
+  }
+  return p;
 }
 
 // Triangles of the quads of the box's own edges, in the order the region

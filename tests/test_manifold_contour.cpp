@@ -124,6 +124,26 @@ TEST(ManifoldContour, EveryCornerConfigurationOfACellIsAClosedManifold) {
   EXPECT_LT(untangled_pairs * 3, tangled_pairs * 2) << untangled_pairs << " pairs left of " << tangled_pairs;
 }
 
+// The sheet round a lone inside corner at (1, 0, 0) of the cell, its normals
+// tilted as trilinear neighbours tilt them (configuration 150's cell): its
+// planes meet in the opposite octant, where its surface turns inside out.
+TEST(ManifoldContour, FarSideOfALoneCornerLiesBehindIt) {
+  detail::CellPlanes planes;
+  planes.add({0.449, 0.0, 0.0}, {-0.699, -0.519, -0.492}, 0, 0);
+  planes.add({1.0, 0.677, 0.0}, {0.567, 0.598, -0.567}, 0, 1);
+  planes.add({1.0, 0.0, 0.690}, {0.547, -0.583, 0.601}, 0, 2);
+  const detail::FarSide far = detail::far_side(planes);
+  EXPECT_TRUE(far.holds({1.775, -0.922, -0.910}));  // where slack 1 used to place it
+  EXPECT_FALSE(far.holds({1.2, 0.2, 0.2}));         // out of the cell, but ahead of the corner
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 1000; ++i) EXPECT_FALSE(far.holds({u(rng), u(rng), u(rng)}));  // (for this sheet)
+  const detail::Qef qef = detail::Qef::of(planes);
+  const glm::dvec3 x = detail::place_vertex(planes, qef, {.cell_slack = 1.0}).position;
+  EXPECT_FALSE(detail::left_the_cell(x)) << x.x << " " << x.y << " " << x.z;
+  EXPECT_FALSE(detail::far_side(detail::CellPlanes{}).holds({-5.0, -5.0, -5.0}));  // no planes: no far side
+}
+
 // With slack a vertex may follow its planes out of its cell, but never round
 // to the far side of the solid corners its sheet wraps: configuration 150
 // (four lone corners) came out as a closed surface of negative volume, with
@@ -136,7 +156,9 @@ TEST(ManifoldContour, SlackNeverTurnsASheetInsideOut) {
       ContourMesh m = contour_world(w, {.cell_slack = 1.0, .untangle = untangle}).value();
       expect_closed_manifold(m, name);
       const MeshQuality q = mesh_quality(m);
-      if (q.triangles > 0) EXPECT_GT(q.volume, 0.0) << name << (untangle ? "" : " without the round");
+      if (q.triangles > 0) {
+        EXPECT_GT(q.volume, 0.0) << name << (untangle ? "" : " without the round");
+      }
     }
   };
   for (unsigned config = 1; config < 256; ++config) {

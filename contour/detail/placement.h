@@ -16,11 +16,13 @@ struct CellPlanes {
   glm::dvec3 point[12];
   glm::dvec3 normal[12];
   uint16_t material[12];
+  uint8_t axis[12];  // of the crossed edge
 
-  void add(const glm::dvec3& p, const glm::dvec3& n, uint16_t m) {
+  void add(const glm::dvec3& p, const glm::dvec3& n, uint16_t m, int edge_axis) {
     point[count] = p;
     normal[count] = n;
     material[count] = m;
+    axis[count] = uint8_t(edge_axis);
     ++count;
   }
   glm::dvec3 mass_point() const;
@@ -69,10 +71,31 @@ inline bool split_along_02(double e02, double e13, const glm::dvec3 p[4], const 
   return glm::length(p[0] - p[2]) <= glm::length(p[1] - p[3]);
 }
 
-// Places the vertex of the cell [cell_min, cell_min + 1]^3.
+// The far side of the solid corners a sheet wraps, for planes in the
+// coordinates of their cell [0, 1]^3: behind the inside end of every one of
+// the sheet's crossed edges (the cell face the edge leaves by, for an edge
+// of a finer level), seen along the sum of those edges' directions (inside
+// end to outside end; a crossing's normal points to the outside end). A vertex there that left its cell has turned its part of the
+// surface inside out, with nothing intersecting: with cell_slack, the
+// planes of a sheet round a lone inside corner (normals tilted by the
+// neighbouring nodes) can meet there, and a cell with four lone inside
+// corners (corner configuration 150) came out as a closed surface of
+// negative volume. A rotated box's corners, which slack is for, lie ahead
+// of the inside ends. Only vertices outside their cell are tested, so
+// nothing changes without slack.
+struct FarSide {
+  glm::dvec3 outward{0.0};
+  double nearest = -INFINITY;  // least dot(outward, inside end) (none: nowhere is the far side)
+  bool holds(const glm::dvec3& x) const { return glm::dot(outward, x) < nearest; }
+};
+FarSide far_side(const CellPlanes& planes);
+bool left_the_cell(const glm::dvec3& x);  // x in cell coordinates
+
+// Places the vertex of planes given in the coordinates of their cell
+// [0, 1]^3, within the cell grown by cell_slack, except that a vertex on the
+// sheet's far side (FarSide) is placed again within the cell.
 // `qef` is Qef::of(planes), computed once by the caller.
-PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const glm::dvec3& cell_min,
-                          const ContourConfig& config);
+PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const ContourConfig& config);
 
 // How many of the QEF's eigenvalues exceed `truncation` times the largest:
 // 1 on a flat piece, 2 on a crease, 3 at a corner.
