@@ -2,6 +2,7 @@
 """Validity sweep: random inputs through the `ldc` tool, every output checked by CGAL.
 
 Usage: python3 bench/validity_sweep.py KIND [--seed S] [--runs N] [--ldc PATH] [--check PATH] [--work DIR]
+                                            [--extra "ARGS"] (added to every command that makes a mesh)
   KIND   boolean | csg | remesh | edit
   boolean  two meshes of tests/data (and ../shared/meshes/suzanne.obj when present), B scaled
            to 0.3-1x A's size and moved by up to 0.3 of it; random op, cells 48-256, and one of:
@@ -90,6 +91,7 @@ def write_obj(path, mesh, r, t):
 class Sweep:
     def __init__(self, args):
         self.ldc, self.check, self.work = args.ldc, args.check, args.work
+        self.extra = args.extra.split()
         self.invalid = 0
         self.fell_back = 0
 
@@ -98,7 +100,7 @@ class Sweep:
 
     def run_ldc(self, cmd, case):
         """Runs an ldc command with --json; counts (and prints) a level mesh that fell back to one level."""
-        r = self.run(cmd + ["--json"])
+        r = self.run(cmd + self.extra + ["--json"])
         if r.returncode == 0:
             try:
                 levels = json.loads(r.stdout).get("surface_levels", {})
@@ -214,7 +216,7 @@ class Sweep:
         extra = rng.choice([["--max-error", "0.2"], ["--max-error", "0.2"], ["--max-error", "0.5"], [],
                             ["--method", "mc"], ["--lod", "1"]])
         out = os.path.join(self.work, "out.obj")
-        r = self.run([self.ldc, "--threads", "2", "-q", "contour", edited, "-o", out] + extra)
+        r = self.run([self.ldc, "--threads", "2", "-q", "contour", edited, "-o", out] + extra + self.extra)
         if r.returncode != 0:
             print("LDC-ERROR", i, "contour", extra, r.stderr.strip()[-200:], flush=True)
             return
@@ -230,6 +232,8 @@ def main():
     p.add_argument("--check", default=os.path.join(ROOT, "build", "tests", "cgal_check_mesh"))
     p.add_argument("--meshes", default=None,
                    help="comma-separated OBJ files to use instead of the built-in list (held-out inputs)")
+    p.add_argument("--extra", default="",
+                   help="more ldc arguments for every command that makes a mesh, e.g. '--slack 1'")
     p.add_argument("--work", default=None, help="folder for outputs and kept failing inputs (default: a new temporary one)")
     args = p.parse_args()
     for tool in (args.ldc, args.check):
