@@ -318,7 +318,8 @@ bool left_the_cell(const glm::dvec3& x) {
 
 PlacedVertex place_vertex(const CellPlanes& planes, const Qef& qef, const ContourConfig& config) {
   const double slack = config.cell_slack;
-  PlacedVertex out = place_in_box(planes, qef, glm::dvec3(-slack), glm::dvec3(1.0 + slack), config);
+  // 0.0 - slack: +0 without slack, the bound the placement always had.
+  PlacedVertex out = place_in_box(planes, qef, glm::dvec3(0.0 - slack), glm::dvec3(1.0 + slack), config);
   if (left_the_cell(out.position) && far_side(planes).holds(out.position)) {  // then no slack
     out = place_in_box(planes, qef, glm::dvec3(0.0), glm::dvec3(1.0), config);
     out.clamped = true;
