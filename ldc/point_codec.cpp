@@ -24,21 +24,6 @@ glm::dvec2 to_oct(const glm::dvec3& n) {
   return p;
 }
 
-glm::dvec3 from_oct(const glm::dvec2& p) {
-  glm::dvec3 n(p.x, p.y, 1.0 - std::abs(p.x) - std::abs(p.y));
-  if (n.z < 0.0) {
-    n.x = (1.0 - std::abs(p.y)) * sign_not_zero(p.x);
-    n.y = (1.0 - std::abs(p.x)) * sign_not_zero(p.y);
-  }
-  return glm::normalize(n);
-}
-
-double dequantize(uint32_t q) { return static_cast<double>(q) / kOctMax * 2.0 - 1.0; }
-
-glm::dvec3 decode_exact(uint32_t qx, uint32_t qy) {
-  return from_oct(glm::dvec2(dequantize(qx), dequantize(qy)));
-}
-
 }  // namespace
 
 uint32_t encode_normal(const glm::dvec3& unit_normal) {
@@ -52,12 +37,6 @@ uint32_t encode_normal(const glm::dvec3& unit_normal) {
     return static_cast<uint32_t>(std::lround(std::clamp((v + 1.0) * 0.5 * kOctMax, 0.0, double(kOctMax))));
   };
   return quantize(p.x) | (quantize(p.y) << kOctBits);
-}
-
-glm::vec3 decode_normal(uint32_t code) {
-  uint32_t qx = code & kOctMax;
-  uint32_t qy = (code >> kOctBits) & kOctMax;
-  return glm::vec3(decode_exact(qx, qy));
 }
 
 SurfacePoint decode_point(const PackedPoint& p, int chunk_size, int segment_start) {
