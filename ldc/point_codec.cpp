@@ -8,8 +8,8 @@
 namespace ldc {
 namespace {
 
-constexpr int kOctBits = 15;
-constexpr uint32_t kOctMax = (1u << kOctBits) - 1;  // 32767
+constexpr int kOctBits = kNormalOctBits;
+constexpr uint32_t kOctMax = (1u << kOctBits) - 1;  // 32767 (decode_normal, world.h, reads the same)
 
 double sign_not_zero(double v) { return v >= 0.0 ? 1.0 : -1.0; }
 

@@ -63,6 +63,17 @@ World field_world(int n, const std::vector<double>& values, int chunk_size = 8) 
   return build_from_implicit(field, grid).value();
 }
 
+// Corner configuration `config` (bit c: corner c inside) of the cell [1, 2]^3
+// of a 4^3 block of nodes, with random magnitudes; nodes around it are outside.
+World corner_config_world(unsigned config, std::uniform_real_distribution<double>& magnitude, std::mt19937& rng) {
+  std::vector<double> values(64, 1.0);
+  for (int c = 0; c < 8; ++c) {
+    const glm::ivec3 node = glm::ivec3(1) + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2);
+    values[size_t((node.z * 4 + node.y) * 4 + node.x)] = ((config >> c) & 1 ? -1.0 : 1.0) * magnitude(rng);
+  }
+  return field_world(4, values);
+}
+
 // A closed 2-manifold: every edge twice (once each way), every vertex one disk.
 void expect_closed_manifold(const ContourMesh& m, const std::string& name) {
   const MeshQuality q = mesh_quality(m);
@@ -104,13 +115,7 @@ TEST(ManifoldContour, EveryCornerConfigurationOfACellIsAClosedManifold) {
   std::uniform_real_distribution<double> magnitude(0.2, 1.0);
   size_t untangled_pairs = 0, tangled_pairs = 0;
   for (unsigned config = 1; config < 256; ++config) {
-    // The cell [1, 2]^3 of a 4^3 block of nodes; nodes around it are outside.
-    std::vector<double> values(64, 1.0);
-    for (int c = 0; c < 8; ++c) {
-      const glm::ivec3 node = glm::ivec3(1) + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2);
-      values[size_t((node.z * 4 + node.y) * 4 + node.x)] = ((config >> c) & 1 ? -1.0 : 1.0) * magnitude(rng);
-    }
-    World w = field_world(4, values);
+    World w = corner_config_world(config, magnitude, rng);
     ContourMesh m = contour_world(w).value();
     expect_closed_manifold(m, "config " + std::to_string(config));
     const MeshQuality q = mesh_quality(m);
@@ -162,12 +167,7 @@ TEST(ManifoldContour, SlackNeverTurnsASheetInsideOut) {
     }
   };
   for (unsigned config = 1; config < 256; ++config) {
-    std::vector<double> values(64, 1.0);
-    for (int c = 0; c < 8; ++c) {
-      const glm::ivec3 node = glm::ivec3(1) + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2);
-      values[size_t((node.z * 4 + node.y) * 4 + node.x)] = ((config >> c) & 1 ? -1.0 : 1.0) * magnitude(rng);
-    }
-    expect_outward(field_world(4, values), "config " + std::to_string(config));
+    expect_outward(corner_config_world(config, magnitude, rng), "config " + std::to_string(config));
   }
   for (int trial = 0; trial < 400; ++trial) {  // 2^3 blocks: two more came out inside out
     std::vector<double> values(64, 1.0);
@@ -409,13 +409,9 @@ TEST(UntangleMesh, ClearsEveryCornerConfigurationOfACell) {
   std::uniform_real_distribution<double> magnitude(0.2, 1.0);
   size_t pairs = 0;
   for (unsigned config = 1; config < 256; ++config) {
-    std::vector<double> values(64, 1.0);
-    for (int c = 0; c < 8; ++c) {
-      const glm::ivec3 node = glm::ivec3(1) + glm::ivec3(c & 1, (c >> 1) & 1, c >> 2);
-      values[size_t((node.z * 4 + node.y) * 4 + node.x)] = ((config >> c) & 1 ? -1.0 : 1.0) * magnitude(rng);
-    }
+    const World w = corner_config_world(config, magnitude, rng);
     for (const ContourConfig& c : kTangledConfigs)
-      expect_closed(untangled_mesh(field_world(4, values), &pairs, c), "config " + std::to_string(config));
+      expect_closed(untangled_mesh(w, &pairs, c), "config " + std::to_string(config));
   }
   EXPECT_GT(pairs, 100u);  // the case is real: the contoured meshes had pairs to clear
 }

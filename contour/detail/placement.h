@@ -75,14 +75,15 @@ inline bool split_along_02(double e02, double e13, const glm::dvec3 p[4], const 
 // coordinates of their cell [0, 1]^3: behind the inside end of every one of
 // the sheet's crossed edges (the cell face the edge leaves by, for an edge
 // of a finer level), seen along the sum of those edges' directions (inside
-// end to outside end; a crossing's normal points to the outside end). A vertex there that left its cell has turned its part of the
-// surface inside out, with nothing intersecting: with cell_slack, the
-// planes of a sheet round a lone inside corner (normals tilted by the
-// neighbouring nodes) can meet there, and a cell with four lone inside
-// corners (corner configuration 150) came out as a closed surface of
-// negative volume. A rotated box's corners, which slack is for, lie ahead
-// of the inside ends. Only vertices outside their cell are tested, so
-// nothing changes without slack.
+// end to outside end; a crossing's normal points to the outside end). A
+// vertex there that left its cell has turned its part of the surface inside
+// out, with nothing intersecting: with cell_slack, the planes of a sheet
+// round a lone inside corner (normals tilted by the neighbouring nodes) can
+// meet there, and a cell with four lone inside corners (corner
+// configuration 150) came out as a closed surface of negative volume. A
+// rotated box's corners, which slack is for, lie ahead of the inside ends.
+// Only vertices outside their cell are tested, so nothing changes without
+// slack.
 struct FarSide {
   glm::dvec3 outward{0.0};
   double nearest = -INFINITY;  // least dot(outward, inside end) (none: nowhere is the far side)
